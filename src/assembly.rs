@@ -1,0 +1,347 @@
+//! Residual and sparse tangent assembly over integration points, shared by the material point
+//! solvers (points = material points, supports = GIMP/MPM weights) and the finite element
+//! comparators (points = Gauss points, supports = element shape functions).
+//!
+//! Each point contributes `f_p = [G]ᵀ{σ} V_p` (eq 29) and `K_p = [G]ᵀ[a][G] V_p` (eq 27),
+//! where [G] holds ∂S/∂x = ∂S/∂X̃ · ΔF⁻¹ (eqs 36, 41). Points are evaluated in parallel into
+//! per-point slots; the scatter runs serially in point order, so results do not depend on
+//! the thread count.
+
+use crate::constitutive::ConstitutiveModel;
+use crate::error::StepFailure;
+use crate::kinematics::{evaluate_point, PointState, PointTrial};
+use crate::linear::SparseSystem;
+use crate::newton::NonlinearSystem;
+use crate::tensor::ij;
+use nalgebra::{SMatrix, SVector};
+use rayon::prelude::*;
+
+/// Most nodes one integration point may touch (4 per axis in 3D).
+pub const MAX_POINT_NODES: usize = 64;
+
+/// For every point: the nodes it touches, the weights S and gradients ∂S/∂X̃ on the
+/// start-of-step configuration. Stored flat (CSR-like) and refilled every load step.
+#[derive(Debug, Clone, Default)]
+pub struct SupportTable<const D: usize> {
+    offsets: Vec<usize>,
+    nodes: Vec<usize>,
+    weights: Vec<f64>,
+    gradients: Vec<SVector<f64, D>>,
+}
+
+impl<const D: usize> SupportTable<D> {
+    pub fn clear(&mut self) {
+        self.offsets.clear();
+        self.offsets.push(0);
+        self.nodes.clear();
+        self.weights.clear();
+        self.gradients.clear();
+    }
+    /// Append one node to the current point.
+    #[inline]
+    pub fn push_node(&mut self, node: usize, s: f64, grad: SVector<f64, D>) {
+        self.nodes.push(node);
+        self.weights.push(s);
+        self.gradients.push(grad);
+    }
+    /// Close the current point. Its node count must not exceed [`MAX_POINT_NODES`].
+    pub fn finish_point(&mut self) {
+        if self.offsets.is_empty() {
+            self.offsets.push(0);
+        }
+        let start = *self.offsets.last().unwrap();
+        assert!(
+            self.nodes.len() - start <= MAX_POINT_NODES,
+            "point support exceeds MAX_POINT_NODES"
+        );
+        self.offsets.push(self.nodes.len());
+    }
+    pub fn num_points(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+    /// Nodes, weights and gradients of point `p`.
+    #[inline]
+    pub fn point(&self, p: usize) -> (&[usize], &[f64], &[SVector<f64, D>]) {
+        let (a, b) = (self.offsets[p], self.offsets[p + 1]);
+        (&self.nodes[a..b], &self.weights[a..b], &self.gradients[a..b])
+    }
+    /// Interpolate a nodal vector field (`D` values per node) to point `p`: Σ S_a u_a.
+    pub fn interpolate(&self, p: usize, nodal: &[f64]) -> SVector<f64, D> {
+        let (nodes, s, _) = self.point(p);
+        let mut u = SVector::<f64, D>::zeros();
+        for (&n, &w) in nodes.iter().zip(s) {
+            for i in 0..D {
+                u[i] += w * nodal[n * D + i];
+            }
+        }
+        u
+    }
+    /// ∂u/∂X̃ at point `p` from nodal values, eq (32).
+    pub fn gradient(&self, p: usize, nodal: &[f64]) -> SMatrix<f64, D, D> {
+        let (nodes, _, g) = self.point(p);
+        let mut gu = SMatrix::<f64, D, D>::zeros();
+        for (&n, ga) in nodes.iter().zip(g) {
+            for i in 0..D {
+                let ui = nodal[n * D + i];
+                for j in 0..D {
+                    gu[(i, j)] += ui * ga[j];
+                }
+            }
+        }
+        gu
+    }
+}
+
+/// Equation numbers of the nodal degrees of freedom: `None` for fixed or inactive ones.
+#[derive(Debug, Clone, Default)]
+pub struct DofMap {
+    eq: Vec<Option<usize>>,
+    count: usize,
+}
+
+impl DofMap {
+    /// Active nodes are those touched by a point with a non-zero weight or gradient; a dof is
+    /// free if its node is active and `(node, axis)` is not in `fixed`.
+    pub fn build<const D: usize>(
+        num_nodes: usize,
+        table: &SupportTable<D>,
+        fixed: &[(usize, usize)],
+    ) -> Self {
+        let mut active = vec![false; num_nodes];
+        for p in 0..table.num_points() {
+            let (nodes, s, g) = table.point(p);
+            for k in 0..nodes.len() {
+                if s[k] != 0.0 || g[k].iter().any(|&x| x != 0.0) {
+                    active[nodes[k]] = true;
+                }
+            }
+        }
+        let mut eq: Vec<Option<usize>> = vec![None; num_nodes * D];
+        let mut is_fixed = vec![false; num_nodes * D];
+        for &(n, a) in fixed {
+            if n < num_nodes && a < D {
+                is_fixed[n * D + a] = true;
+            }
+        }
+        let mut count = 0;
+        for n in 0..num_nodes {
+            if !active[n] {
+                continue;
+            }
+            for a in 0..D {
+                if !is_fixed[n * D + a] {
+                    eq[n * D + a] = Some(count);
+                    count += 1;
+                }
+            }
+        }
+        Self { eq, count }
+    }
+    /// Number of equations.
+    pub fn len(&self) -> usize {
+        self.count
+    }
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+    /// Equation of `dof = node * D + axis`.
+    #[inline]
+    pub fn eq(&self, dof: usize) -> Option<usize> {
+        self.eq[dof]
+    }
+    /// Number of nodal dofs (`num_nodes * D`).
+    pub fn num_dofs(&self) -> usize {
+        self.eq.len()
+    }
+    /// Scatter equation values into a nodal vector (zero at fixed/inactive dofs).
+    pub fn expand(&self, u: &[f64], nodal: &mut [f64]) {
+        for (dof, e) in self.eq.iter().enumerate() {
+            nodal[dof] = e.map_or(0.0, |e| u[e]);
+        }
+    }
+    /// Gather a nodal vector into equation order.
+    pub fn gather(&self, nodal: &[f64], u: &mut [f64]) {
+        for (dof, e) in self.eq.iter().enumerate() {
+            if let Some(e) = *e {
+                u[e] = nodal[dof];
+            }
+        }
+    }
+
+    /// Sparsity pattern (per column, the rows) coupling every pair of free dofs that share a point.
+    pub fn pattern<const D: usize>(&self, table: &SupportTable<D>) -> Vec<Vec<usize>> {
+        let mut columns: Vec<Vec<usize>> = vec![Vec::new(); self.count];
+        let mut eqs = Vec::with_capacity(MAX_POINT_NODES * D);
+        for p in 0..table.num_points() {
+            let (nodes, _, _) = table.point(p);
+            eqs.clear();
+            for &n in nodes {
+                for a in 0..D {
+                    if let Some(e) = self.eq[n * D + a] {
+                        eqs.push(e);
+                    }
+                }
+            }
+            for &c in &eqs {
+                columns[c].extend_from_slice(&eqs);
+            }
+        }
+        columns
+    }
+}
+
+/// Nodal external force of body forces carried by points: f_a = Σ_p S_ap b_p (eq 40).
+pub fn map_point_forces<const D: usize>(
+    table: &SupportTable<D>,
+    forces: &[SVector<f64, D>],
+    nodal: &mut [f64],
+) {
+    for (p, f) in forces.iter().enumerate() {
+        let (nodes, s, _) = table.point(p);
+        for (&n, &w) in nodes.iter().zip(s) {
+            for i in 0..D {
+                nodal[n * D + i] += w * f[i];
+            }
+        }
+    }
+}
+
+/// One load step's nonlinear system over a set of integration points.
+pub struct LoadStepSystem<'a, const D: usize> {
+    pub model: &'a dyn ConstitutiveModel,
+    pub states: &'a [PointState],
+    pub table: &'a SupportTable<D>,
+    pub dofs: &'a DofMap,
+    /// External force in equation order.
+    pub f_ext: &'a [f64],
+    pub matrix: &'a mut SparseSystem,
+    /// Per-point trial results at the last evaluation (committed by the caller on convergence).
+    pub trials: &'a mut Vec<Option<PointTrial<D>>>,
+    /// Nodal displacement increment at the last evaluation.
+    pub du_nodal: &'a mut Vec<f64>,
+    /// Form the tangent during `evaluate`.
+    pub with_tangent: bool,
+}
+
+impl<const D: usize> LoadStepSystem<'_, D> {
+    /// Evaluate all points at the nodal increment and assemble the internal force (in
+    /// equation order) and, if requested, the tangent.
+    pub fn assemble(&mut self, f_int: &mut [f64]) -> Result<(), StepFailure> {
+        let model = self.model;
+        let table = self.table;
+        let du = &*self.du_nodal;
+        let with_tangent = self.with_tangent;
+        self.trials.resize(self.states.len(), None);
+        let first_error = self
+            .trials
+            .par_iter_mut()
+            .zip(self.states.par_iter())
+            .enumerate()
+            .map(|(p, (slot, state))| {
+                let grad = table.gradient(p, du);
+                match evaluate_point::<D>(model, state, &grad, with_tangent) {
+                    Ok(t) => {
+                        *slot = Some(t);
+                        None
+                    }
+                    Err(e) => {
+                        *slot = None;
+                        Some((p, e.to_string()))
+                    }
+                }
+            })
+            .reduce(
+                || None,
+                |a, b| match (a, b) {
+                    (Some(x), Some(y)) => Some(if x.0 <= y.0 { x } else { y }),
+                    (x, None) => x,
+                    (None, y) => y,
+                },
+            );
+        if let Some((point, reason)) = first_error {
+            return Err(StepFailure::Kinematics { point, reason });
+        }
+        f_int.iter_mut().for_each(|v| *v = 0.0);
+        if with_tangent {
+            self.matrix.clear_values();
+        }
+        let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
+        let mut eqs = [None; MAX_POINT_NODES * 3];
+        for p in 0..self.states.len() {
+            let t = self.trials[p].as_ref().expect("evaluated");
+            let (nodes, _, g) = table.point(p);
+            let m = nodes.len();
+            // ∂S/∂x_j = ∂S/∂X̃_i (ΔF⁻¹)_ij, eq (36).
+            let inv_t = t.delta_f_inv.transpose();
+            for k in 0..m {
+                gx[k] = inv_t * g[k];
+                for i in 0..D {
+                    eqs[k * D + i] = self.dofs.eq(nodes[k] * D + i);
+                }
+            }
+            let v = t.volume;
+            for k in 0..m {
+                for i in 0..D {
+                    if let Some(e) = eqs[k * D + i] {
+                        let mut s = 0.0;
+                        for j in 0..D {
+                            s += t.sigma[(i, j)] * gx[k][j];
+                        }
+                        f_int[e] += s * v; // eq (29)
+                    }
+                }
+            }
+            if let (true, Some(a)) = (with_tangent, t.tangent.as_ref()) {
+                // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V, eq (27).
+                for kb in 0..m {
+                    for k in 0..D {
+                        let Some(col) = eqs[kb * D + k] else { continue };
+                        // c_ij = Σ_l a_ijkl g_b,l
+                        let mut c = [[0.0; 3]; 3];
+                        for i in 0..D {
+                            for j in 0..D {
+                                let mut s = 0.0;
+                                for l in 0..D {
+                                    s += a[(ij(i, j), ij(k, l))] * gx[kb][l];
+                                }
+                                c[i][j] = s * v;
+                            }
+                        }
+                        for ka in 0..m {
+                            for i in 0..D {
+                                let Some(row) = eqs[ka * D + i] else { continue };
+                                let mut s = 0.0;
+                                for j in 0..D {
+                                    s += gx[ka][j] * c[i][j];
+                                }
+                                self.matrix.add(row, col, s);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
+    fn len(&self) -> usize {
+        self.dofs.len()
+    }
+    fn evaluate(&mut self, u: &[f64], residual: &mut [f64]) -> Result<(), StepFailure> {
+        self.du_nodal.resize(self.dofs.num_dofs(), 0.0);
+        self.dofs.expand(u, self.du_nodal);
+        self.assemble(residual)?;
+        for (r, f) in residual.iter_mut().zip(self.f_ext) {
+            *r -= f;
+        }
+        Ok(())
+    }
+    fn solve_tangent(&mut self, rhs: &mut [f64]) -> Result<(), StepFailure> {
+        self.matrix.solve_in_place(rhs).map_err(StepFailure::Singular)
+    }
+    fn reference_norm(&self) -> f64 {
+        self.f_ext.iter().map(|x| x * x).sum::<f64>().sqrt()
+    }
+}

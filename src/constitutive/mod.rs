@@ -1,0 +1,87 @@
+//! Constitutive models in log-strain / Kirchhoff-stress space (eq 14), shared unchanged by
+//! the material point solvers and the finite element comparators.
+//!
+//! The boundary sits where the paper puts it: a model receives the *trial* elastic
+//! logarithmic strain (eq 19) and the committed state of the previous converged load step,
+//! and returns the Kirchhoff stress, the updated elastic strain and the algorithmic tangent
+//! `D^alg = ∂τ/∂ε^e_trial`. The finite-deformation wrapping (eqs 15–19, 25) lives in
+//! [`crate::kinematics`], once for every model. Updates are pure functions: committing
+//! happens in the solver after Newton converges.
+
+mod linear_elastic;
+
+pub use linear_elastic::LinearElastic;
+
+use crate::error::InputError;
+use crate::tensor::Tensor4;
+use nalgebra::Matrix3;
+use serde::{Deserialize, Serialize};
+
+/// Committed constitutive state of one material or Gauss point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MaterialState {
+    /// Elastic logarithmic strain ε^e of the last converged step.
+    pub eps_e: Matrix3<f64>,
+    /// Elastic left Cauchy–Green tensor b^e = exp(2 ε^e), eq (18), kept to avoid recomputing it.
+    pub b_e: Matrix3<f64>,
+    /// Accumulated plastic multiplier (equivalent plastic strain measure), 0 for elastic models.
+    pub plastic_multiplier: f64,
+}
+
+impl Default for MaterialState {
+    fn default() -> Self {
+        Self {
+            eps_e: Matrix3::zeros(),
+            b_e: Matrix3::identity(),
+            plastic_multiplier: 0.0,
+        }
+    }
+}
+
+/// What a stress update returns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MaterialResponse {
+    /// Kirchhoff stress τ.
+    pub tau: Matrix3<f64>,
+    /// Updated elastic logarithmic strain.
+    pub eps_e: Matrix3<f64>,
+    /// Algorithmic tangent D^alg = ∂τ/∂ε^e_trial.
+    pub d_alg: Tensor4,
+    /// Updated accumulated plastic multiplier.
+    pub plastic_multiplier: f64,
+}
+
+/// A stress update failed (e.g. the return map did not converge).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct MaterialError(pub String);
+
+/// A constitutive model in log-strain / Kirchhoff space.
+pub trait ConstitutiveModel: Send + Sync {
+    /// Stress update from the trial elastic log strain and the committed state. Pure.
+    fn update(
+        &self,
+        eps_trial: &Matrix3<f64>,
+        committed: &MaterialState,
+    ) -> Result<MaterialResponse, MaterialError>;
+}
+
+/// The models igimp ships, selectable from study files.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "model", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum Material {
+    /// Linear elasticity in principal logarithmic strain (Hencky), eq (14).
+    LinearElastic { young_modulus: f64, poisson_ratio: f64 },
+}
+
+impl Material {
+    /// Validate the parameters and build the model.
+    pub fn build(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
+        match *self {
+            Material::LinearElastic {
+                young_modulus,
+                poisson_ratio,
+            } => Ok(Box::new(LinearElastic::try_new(young_modulus, poisson_ratio)?)),
+        }
+    }
+}

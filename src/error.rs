@@ -1,0 +1,83 @@
+//! Error types: bad input names the field and its allowed range; solver failures carry the
+//! load step and the Newton residual history so that a failed case in a sweep can be reported.
+
+use thiserror::Error;
+
+/// Invalid user input: names the field, the offending value and what is allowed.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("invalid `{field}` = {value}: {allowed}")]
+pub struct InputError {
+    /// Dotted path of the offending field, e.g. `material.young_modulus`.
+    pub field: String,
+    /// The value as given (formatted).
+    pub value: String,
+    /// The allowed range, in words.
+    pub allowed: String,
+}
+
+impl InputError {
+    pub fn new(field: impl Into<String>, value: impl ToString, allowed: impl Into<String>) -> Self {
+        Self {
+            field: field.into(),
+            value: value.to_string(),
+            allowed: allowed.into(),
+        }
+    }
+}
+
+/// Check that `value` is finite and strictly positive.
+pub fn require_positive(field: &str, value: f64) -> Result<(), InputError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(InputError::new(field, value, "must be finite and > 0"))
+    }
+}
+
+/// Check that `value` is finite.
+pub fn require_finite(field: &str, value: f64) -> Result<(), InputError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(InputError::new(field, value, "must be finite"))
+    }
+}
+
+/// Check that a count is at least `min`.
+pub fn require_count(field: &str, value: usize, min: usize) -> Result<(), InputError> {
+    if value >= min {
+        Ok(())
+    } else {
+        Err(InputError::new(
+            field,
+            value,
+            format!("must be an integer >= {min}"),
+        ))
+    }
+}
+
+/// Why a load step failed.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum StepFailure {
+    #[error("Newton did not converge in {iterations} iterations (last normalised residual {last:.3e})")]
+    NotConverged { iterations: usize, last: f64 },
+    #[error("non-finite residual or update at Newton iteration {iteration}")]
+    NonFinite { iteration: usize },
+    #[error("the tangent matrix could not be factorised: {0}")]
+    Singular(String),
+    #[error("material point {point} left the background grid (position {position})")]
+    LeftGrid { point: usize, position: String },
+    #[error("material point {point}: {reason}")]
+    Kinematics { point: usize, reason: String },
+}
+
+/// A load step that failed, with the Newton residual history of that step.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("load step {step}: {failure}; residual history {residuals:?}")]
+pub struct SolveError {
+    /// Load step number, counted from 1.
+    pub step: usize,
+    pub failure: StepFailure,
+    /// Normalised out-of-balance force per Newton iteration of the failing step.
+    pub residuals: Vec<f64>,
+}

@@ -1,0 +1,281 @@
+//! Updated-Lagrangian finite-deformation kinematics shared by every discretisation:
+//! the deformation-gradient increment on the start-of-step configuration (eq 31), the trial
+//! elastic left Cauchy–Green tensor and log strain (eqs 15–19), Cauchy stress (eq 16), the
+//! spatial consistent tangent (eq 25), the spatial derivative mapping (eqs 35–36) and the
+//! stretch tensor used to update domains (eq 38).
+//!
+//! All per-point tensors are 3×3 even in 1D and 2D: a `D`-dimensional problem deforms the
+//! leading `D×D` block of F and keeps the out-of-plane stretches at one (uniaxial strain in
+//! 1D, plane strain in 2D), so one constitutive code serves all dimensions.
+
+use crate::constitutive::{ConstitutiveModel, MaterialResponse, MaterialState};
+use crate::tensor::{ij, Tensor4};
+use nalgebra::{Matrix3, SMatrix, SymmetricEigen, Vector3};
+
+/// Eigen-decomposition of a symmetric 3×3 matrix: eigenvalues and eigenvectors (columns).
+#[inline]
+pub fn sym_eigen(m: &Matrix3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
+    let e = SymmetricEigen::new(*m);
+    (e.eigenvalues, e.eigenvectors)
+}
+
+/// Isotropic function of a symmetric matrix from its spectral decomposition.
+#[inline]
+pub fn spectral_map(lam: &Vector3<f64>, q: &Matrix3<f64>, f: impl Fn(f64) -> f64) -> Matrix3<f64> {
+    let d = Matrix3::from_diagonal(&lam.map(f));
+    q * d * q.transpose()
+}
+
+/// Logarithmic strain ε = ½ ln b, eqs (15) and (19). Requires b symmetric positive definite.
+pub fn log_strain(b: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+    let (lam, q) = sym_eigen(b);
+    if lam.iter().any(|&l| !(l > 0.0 && l.is_finite())) {
+        return None;
+    }
+    Some(spectral_map(&lam, &q, |l| 0.5 * l.ln()))
+}
+
+/// b = exp(2ε), eq (18).
+pub fn left_cauchy_green_from_strain(eps: &Matrix3<f64>) -> Matrix3<f64> {
+    let (lam, q) = sym_eigen(eps);
+    spectral_map(&lam, &q, |l| (2.0 * l).exp())
+}
+
+/// Right stretch tensor U = √(FᵀF), eq (38).
+pub fn stretch_tensor(f: &Matrix3<f64>) -> Matrix3<f64> {
+    let (lam, q) = sym_eigen(&(f.transpose() * f));
+    spectral_map(&lam, &q, |l| l.max(0.0).sqrt())
+}
+
+/// First divided difference of ln at (a, b), stable as a → b (limit 1/a).
+#[inline]
+fn ln_divided_difference(a: f64, b: f64) -> f64 {
+    let d = a - b;
+    if d == 0.0 {
+        1.0 / b
+    } else {
+        (d / b).ln_1p() / d
+    }
+}
+
+/// L_mnpq = ∂ ln(b)_mn / ∂ b_pq (eq 26) by the Daleckii–Krein formula for the derivative of a
+/// symmetric matrix function: `dln(b)[H] = Q (Θ ∘ QᵀHQ) Qᵀ` with `Θ_aa = 1/λ_a` and
+/// `Θ_ab = (ln λ_a − ln λ_b)/(λ_a − λ_b)` (the closed form of Miehe's algorithm, ref [102]).
+pub fn dlog(lam: &Vector3<f64>, q: &Matrix3<f64>) -> Tensor4 {
+    let mut theta = Matrix3::zeros();
+    for a in 0..3 {
+        for b in 0..3 {
+            theta[(a, b)] = ln_divided_difference(lam[a], lam[b]);
+        }
+    }
+    let mut l = Tensor4::zeros();
+    for m in 0..3 {
+        for n in 0..3 {
+            for p in 0..3 {
+                for qq in 0..3 {
+                    let mut s = 0.0;
+                    for a in 0..3 {
+                        let ma = q[(m, a)] * q[(p, a)];
+                        for b in 0..3 {
+                            s += ma * q[(n, b)] * q[(qq, b)] * theta[(a, b)];
+                        }
+                    }
+                    l[(ij(m, n), ij(p, qq))] = s;
+                }
+            }
+        }
+    }
+    l
+}
+
+/// Spatial consistent tangent a_ijkl = (1/2J) D^alg_ijmn L_mnpq B_pqkl − σ_il δ_jk, eqs (25)–(26),
+/// with B_pqkl = δ_pk b_ql + δ_qk b_pl evaluated at the trial b^e.
+///
+/// Only entries with all of i, j, k, l < `D` are computed (the rest stay zero): a `D`-dimensional
+/// discretisation never contracts the others.
+pub fn spatial_tangent<const D: usize>(
+    d_alg: &Tensor4,
+    l: &Tensor4,
+    b: &Matrix3<f64>,
+    sigma: &Matrix3<f64>,
+    j: f64,
+) -> Tensor4 {
+    // (L B)_{mn,kl} = L_{mn,kq} b_ql + L_{mn,pk} b_pl, only for active k, l.
+    let mut lb = Tensor4::zeros();
+    for r in 0..9 {
+        for k in 0..D {
+            for ll in 0..D {
+                let mut s = 0.0;
+                for q in 0..3 {
+                    s += l[(r, ij(k, q))] * b[(q, ll)] + l[(r, ij(q, k))] * b[(q, ll)];
+                }
+                lb[(r, ij(k, ll))] = s;
+            }
+        }
+    }
+    let mut a = Tensor4::zeros();
+    let scale = 0.5 / j;
+    for i in 0..D {
+        for jj in 0..D {
+            let row = ij(i, jj);
+            for k in 0..D {
+                for ll in 0..D {
+                    let col = ij(k, ll);
+                    let mut s = 0.0;
+                    for r in 0..9 {
+                        s += d_alg[(row, r)] * lb[(r, col)];
+                    }
+                    a[(row, col)] = scale * s - if jj == k { sigma[(i, ll)] } else { 0.0 };
+                }
+            }
+        }
+    }
+    a
+}
+
+/// Embed a `D×D` displacement-gradient block into the 3×3 deformation-gradient increment
+/// ΔF = I + ∂Δu/∂X̃, eq (31).
+#[inline]
+pub fn delta_f_from_gradient<const D: usize>(grad_du: &SMatrix<f64, D, D>) -> Matrix3<f64> {
+    let mut df = Matrix3::identity();
+    for i in 0..D {
+        for j in 0..D {
+            df[(i, j)] += grad_du[(i, j)];
+        }
+    }
+    df
+}
+
+/// The state of one integration point (material point or Gauss point) at the last
+/// converged load step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointState {
+    /// Deformation gradient F_n.
+    pub f: Matrix3<f64>,
+    /// Volume V_p^n in the last converged configuration.
+    pub volume: f64,
+    /// Kirchhoff stress τ of the last converged step (σ = τ / det F).
+    pub tau: Matrix3<f64>,
+    /// Committed constitutive state.
+    pub material: MaterialState,
+}
+
+impl PointState {
+    /// Cauchy stress σ = τ / det F, eq (16).
+    pub fn cauchy(&self) -> Matrix3<f64> {
+        self.tau / self.f.determinant()
+    }
+
+    /// Undeformed state with volume `volume`.
+    pub fn undeformed(volume: f64) -> Self {
+        Self {
+            f: Matrix3::identity(),
+            volume,
+            tau: Matrix3::zeros(),
+            material: MaterialState::default(),
+        }
+    }
+}
+
+/// Result of evaluating one integration point at a trial displacement increment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointTrial<const D: usize> {
+    /// ΔF, eq (31).
+    pub delta_f: Matrix3<f64>,
+    /// F = ΔF F_n, eq (30).
+    pub f: Matrix3<f64>,
+    /// Cauchy stress σ = τ/J, eq (16).
+    pub sigma: Matrix3<f64>,
+    /// Current volume V_p = det(ΔF) V_p^n, eq (28).
+    pub volume: f64,
+    /// Inverse of the in-plane block of ΔF, mapping ∂/∂X̃ to ∂/∂x (eqs 35–36).
+    pub delta_f_inv: SMatrix<f64, D, D>,
+    /// Constitutive response (τ, ε^e, D^alg).
+    pub response: MaterialResponse,
+    /// Spatial tangent, eq (25), when requested.
+    pub tangent: Option<Tensor4>,
+}
+
+/// Why a point could not be evaluated.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PointError {
+    /// det ΔF ≤ 0 or non-finite: the trial increment inverts the material.
+    Inverted(f64),
+    /// The trial b^e is not positive definite or not finite.
+    BadStrain,
+    /// The constitutive update failed.
+    Material(String),
+}
+
+impl std::fmt::Display for PointError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PointError::Inverted(j) => write!(f, "det(dF) = {j:e} <= 0: the increment inverts the material"),
+            PointError::BadStrain => write!(f, "trial elastic b is not symmetric positive definite"),
+            PointError::Material(m) => write!(f, "constitutive update failed: {m}"),
+        }
+    }
+}
+
+/// Evaluate one integration point: trial kinematics (eqs 17, 19, 30, 31), the stress update,
+/// Cauchy stress (eq 16), current volume (eq 28) and, if `tangent`, the spatial tangent (eq 25).
+///
+/// `grad_du` is ∂Δu/∂X̃ on the start-of-step configuration (eq 32).
+pub fn evaluate_point<const D: usize>(
+    model: &dyn ConstitutiveModel,
+    state: &PointState,
+    grad_du: &SMatrix<f64, D, D>,
+    tangent: bool,
+) -> Result<PointTrial<D>, PointError> {
+    let delta_f = delta_f_from_gradient(grad_du);
+    let det_df = delta_f.determinant();
+    if !(det_df > 0.0 && det_df.is_finite()) {
+        return Err(PointError::Inverted(det_df));
+    }
+    let f = delta_f * state.f;
+    let j = det_df * state.f.determinant();
+    let b_trial = delta_f * state.material.b_e * delta_f.transpose(); // eq (17)
+    let b_trial = 0.5 * (b_trial + b_trial.transpose());
+    let (lam, q) = sym_eigen(&b_trial);
+    if lam.iter().any(|&l| !(l > 0.0 && l.is_finite())) {
+        return Err(PointError::BadStrain);
+    }
+    let eps_trial = spectral_map(&lam, &q, |l| 0.5 * l.ln()); // eq (19)
+    let response = model
+        .update(&eps_trial, &state.material)
+        .map_err(|e| PointError::Material(e.0))?;
+    let sigma = response.tau / j; // eq (16)
+    let tangent = if tangent {
+        let l = dlog(&lam, &q);
+        Some(spatial_tangent::<D>(&response.d_alg, &l, &b_trial, &sigma, j))
+    } else {
+        None
+    };
+    let block = SMatrix::<f64, D, D>::from_fn(|r, c| delta_f[(r, c)]);
+    let delta_f_inv = block.try_inverse().ok_or(PointError::Inverted(det_df))?;
+    Ok(PointTrial {
+        delta_f,
+        f,
+        sigma,
+        volume: det_df * state.volume,
+        delta_f_inv,
+        response,
+        tangent,
+    })
+}
+
+impl<const D: usize> PointTrial<D> {
+    /// The state to commit once the load step has converged.
+    pub fn committed(&self) -> PointState {
+        PointState {
+            f: self.f,
+            volume: self.volume,
+            tau: self.response.tau,
+            material: MaterialState {
+                eps_e: self.response.eps_e,
+                b_e: left_cauchy_green_from_strain(&self.response.eps_e),
+                plastic_multiplier: self.response.plastic_multiplier,
+            },
+        }
+    }
+}

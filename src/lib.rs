@@ -1,0 +1,39 @@
+//! # igimp — implicit Generalised Interpolation Material Point method
+//!
+//! A reference implementation of Charlton, Coombs & Augarde, *iGIMP: An implicit Generalised
+//! Interpolation Material Point Method for large deformations* (the paper; equation numbers in
+//! the docs refer to it), with the verification studies that reproduce its results.
+//!
+//! ## Pipeline
+//! [`grid`] (regular background grid) → [`basis`] (MPM / GIMP weights, eqs 7–10) →
+//! [`assembly`] (per-point residual and tangent, eqs 27–29, 36, 41) with [`kinematics`]
+//! (ΔF, log strain, spatial tangent; eqs 15–19, 25, 30–36) and [`constitutive`] (eq 14) →
+//! [`linear`] (sparse LU with cached symbolic factorisation) → [`newton`] (eqs 22–23) →
+//! [`mpm`] (load steps, commit, domain update eqs 37–39). [`problems`] holds the paper's
+//! examples with their analytical solutions; [`norms`] the error measures (eqs 46–47).
+//!
+//! ## Notation
+//! | paper | Rust |
+//! |---|---|
+//! | S_vp, ∇S_vp | `Support::node`, `SupportTable::point` |
+//! | F, ΔF | `PointState::f`, `PointTrial::delta_f` |
+//! | b^e, ε^e | `MaterialState::b_e`, `MaterialState::eps_e` |
+//! | τ, σ | `MaterialResponse::tau`, `PointTrial::sigma` |
+//! | D^alg, a_ijkl | `MaterialResponse::d_alg`, `PointTrial::tangent` |
+//! | V_p, V_p^n | `PointTrial::volume`, `PointState::volume` |
+//! | l_p | `MaterialPoints::half_length` (half of l_p) |
+
+pub mod assembly;
+pub mod basis;
+pub mod constitutive;
+pub mod error;
+pub mod fem;
+pub mod grid;
+pub mod kinematics;
+pub mod linear;
+pub mod mpm;
+pub mod newton;
+pub mod norms;
+pub mod particles;
+pub mod problems;
+pub mod tensor;

@@ -1,0 +1,277 @@
+//! The implicit material point solver: load-step loop, Newton solve and commit (Figures 6–7).
+
+use crate::assembly::{map_point_forces, DofMap, LoadStepSystem, SupportTable};
+use crate::basis::{Basis, Support};
+use crate::constitutive::ConstitutiveModel;
+use crate::error::{require_count, InputError, SolveError, StepFailure};
+use crate::grid::Grid;
+use crate::kinematics::{stretch_tensor, PointTrial};
+use crate::linear::SparseSystem;
+use crate::newton::{self, NewtonReport, NewtonSettings};
+use crate::particles::MaterialPoints;
+use nalgebra::SVector;
+use serde::{Deserialize, Serialize};
+
+/// How material point domains are updated at the end of a load step (§3.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum DomainUpdate {
+    /// l_i = l_i0 U_ii with the right stretch tensor U = √(FᵀF), eq (39) (the paper's choice).
+    #[default]
+    Stretch,
+    /// l_i = l_i0 F_ii, eq (37) (cpGIMP); fails under large rotation.
+    FDiagonal,
+    /// Domains never change (uGIMP).
+    Fixed,
+}
+
+/// Solver settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MpmSettings {
+    pub basis: Basis,
+    pub domain_update: DomainUpdate,
+    pub newton: NewtonSettings,
+    /// Number of equal load increments.
+    pub load_steps: usize,
+}
+
+impl MpmSettings {
+    pub fn validate(&self) -> Result<(), InputError> {
+        self.newton.validate()?;
+        require_count("load_steps", self.load_steps, 1)?;
+        if self.load_steps > 1_000_000 {
+            return Err(InputError::new(
+                "load_steps",
+                self.load_steps,
+                "must be <= 1000000",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// External loads at the end of the analysis, applied proportionally over the load steps.
+#[derive(Debug, Clone)]
+pub struct Loads<const D: usize> {
+    /// Gravitational acceleration (body force per unit mass).
+    pub gravity: SVector<f64, D>,
+    /// Point loads carried by material points: (point, force).
+    pub point_loads: Vec<(usize, SVector<f64, D>)>,
+}
+
+/// What one converged load step did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StepReport {
+    /// Load step number, from 1.
+    pub step: usize,
+    pub load_factor: f64,
+    pub newton: NewtonReport,
+}
+
+/// Implicit MPM / GIMP solver for `D` dimensions.
+pub struct MpmSolver<const D: usize> {
+    pub grid: Grid<D>,
+    pub points: MaterialPoints<D>,
+    model: Box<dyn ConstitutiveModel>,
+    /// Homogeneous Dirichlet conditions: (node, axis).
+    pub fixed: Vec<(usize, usize)>,
+    pub loads: Loads<D>,
+    pub settings: MpmSettings,
+    step: usize,
+    table: SupportTable<D>,
+    matrix: SparseSystem,
+    trials: Vec<Option<PointTrial<D>>>,
+    du_nodal: Vec<f64>,
+}
+
+impl<const D: usize> MpmSolver<D> {
+    pub fn try_new(
+        grid: Grid<D>,
+        points: MaterialPoints<D>,
+        model: Box<dyn ConstitutiveModel>,
+        fixed: Vec<(usize, usize)>,
+        loads: Loads<D>,
+        settings: MpmSettings,
+    ) -> Result<Self, InputError> {
+        settings.validate()?;
+        if points.is_empty() {
+            return Err(InputError::new(
+                "material points",
+                0,
+                "at least one point is required",
+            ));
+        }
+        for p in 0..points.len() {
+            if !grid.contains_box(&points.position[p], &points.half_length[p]) {
+                return Err(InputError::new(
+                    format!("material point {p}"),
+                    format!("{:?}", points.position[p].as_slice()),
+                    "point and its domain must lie inside the background grid",
+                ));
+            }
+        }
+        for &(n, a) in &fixed {
+            if n >= grid.num_nodes() || a >= D {
+                return Err(InputError::new(
+                    "fixed dof",
+                    format!("(node {n}, axis {a})"),
+                    format!("node < {} and axis < {D}", grid.num_nodes()),
+                ));
+            }
+        }
+        for a in 0..D {
+            crate::error::require_finite(&format!("gravity[{a}]"), loads.gravity[a])?;
+        }
+        for (p, f) in &loads.point_loads {
+            if *p >= points.len() || f.iter().any(|v| !v.is_finite()) {
+                return Err(InputError::new(
+                    "point load",
+                    format!("(point {p}, {:?})", f.as_slice()),
+                    format!("point < {} and finite force", points.len()),
+                ));
+            }
+        }
+        Ok(Self {
+            grid,
+            points,
+            model,
+            fixed,
+            loads,
+            settings,
+            step: 0,
+            table: SupportTable::default(),
+            matrix: SparseSystem::default(),
+            trials: Vec::new(),
+            du_nodal: Vec::new(),
+        })
+    }
+
+    /// Load steps completed so far.
+    pub fn steps_done(&self) -> usize {
+        self.step
+    }
+
+    /// The constitutive model.
+    pub fn model(&self) -> &dyn ConstitutiveModel {
+        self.model.as_ref()
+    }
+
+    /// Evaluate the weights of every point on the grid at the current positions and domains.
+    pub fn build_supports(&mut self) -> Result<(), StepFailure> {
+        let basis = self.settings.basis;
+        self.table.clear();
+        let mut sup = Support::<D>::default();
+        for p in 0..self.points.len() {
+            basis
+                .evaluate(
+                    &self.grid,
+                    &self.points.position[p],
+                    &self.points.half_length[p],
+                    &mut sup,
+                )
+                .map_err(|e| StepFailure::LeftGrid {
+                    point: p,
+                    position: format!("{:?}: {e}", self.points.position[p].as_slice()),
+                })?;
+            for k in 0..sup.len() {
+                let (node, s, g) = sup.node(&self.grid, k);
+                self.table.push_node(node, s, g);
+            }
+            self.table.finish_point();
+        }
+        Ok(())
+    }
+
+    /// Supports of the last [`Self::build_supports`].
+    pub fn supports(&self) -> &SupportTable<D> {
+        &self.table
+    }
+
+    /// Solve the next load step and commit it.
+    pub fn step(&mut self) -> Result<StepReport, SolveError> {
+        let step = self.step + 1;
+        let fail = |failure, residuals| SolveError {
+            step,
+            failure,
+            residuals,
+        };
+        let load_factor = step as f64 / self.settings.load_steps as f64;
+        self.build_supports().map_err(|f| fail(f, vec![]))?;
+        let dofs = DofMap::build(self.grid.num_nodes(), &self.table, &self.fixed);
+        self.matrix.set_pattern(dofs.pattern(&self.table));
+        let forces: Vec<SVector<f64, D>> = self.external_point_forces(load_factor);
+        let mut nodal = vec![0.0; dofs.num_dofs()];
+        map_point_forces(&self.table, &forces, &mut nodal); // eq (40)
+        let mut f_ext = vec![0.0; dofs.len()];
+        dofs.gather(&nodal, &mut f_ext);
+        let mut u = vec![0.0; dofs.len()];
+        let report = {
+            let mut system = LoadStepSystem {
+                model: self.model.as_ref(),
+                states: &self.points.state,
+                table: &self.table,
+                dofs: &dofs,
+                f_ext: &f_ext,
+                matrix: &mut self.matrix,
+                trials: &mut self.trials,
+                du_nodal: &mut self.du_nodal,
+                with_tangent: true,
+            };
+            newton::solve(&mut system, &mut u, &self.settings.newton).map_err(|(f, r)| fail(f, r))?
+        };
+        self.commit();
+        self.step = step;
+        Ok(StepReport {
+            step,
+            load_factor,
+            newton: report,
+        })
+    }
+
+    fn external_point_forces(&self, load_factor: f64) -> Vec<SVector<f64, D>> {
+        let mut forces: Vec<SVector<f64, D>> = self
+            .points
+            .mass
+            .iter()
+            .map(|&m| self.loads.gravity * (m * load_factor))
+            .collect();
+        for (p, f) in &self.loads.point_loads {
+            forces[*p] += f * load_factor;
+        }
+        forces
+    }
+
+    /// Commit the converged step: states, positions (x += Σ S Δu) and domains (eqs 37/39).
+    fn commit(&mut self) {
+        for p in 0..self.points.len() {
+            let trial = self.trials[p].as_ref().expect("converged trial");
+            let new_state = trial.committed();
+            self.points.state[p] = new_state;
+            let du = self.table.interpolate(p, &self.du_nodal);
+            self.points.position[p] += du;
+            let r0 = self.points.half_length0[p];
+            let f = new_state.f;
+            self.points.half_length[p] = match self.settings.domain_update {
+                DomainUpdate::Stretch => {
+                    let u = stretch_tensor(&f);
+                    SVector::<f64, D>::from_fn(|a, _| r0[a] * u[(a, a)])
+                }
+                DomainUpdate::FDiagonal => SVector::<f64, D>::from_fn(|a, _| r0[a] * f[(a, a)]),
+                DomainUpdate::Fixed => r0,
+            };
+        }
+    }
+
+    /// Run all remaining load steps. On failure returns the reports of the converged steps
+    /// and the error.
+    pub fn run(&mut self) -> Result<Vec<StepReport>, (Vec<StepReport>, SolveError)> {
+        let mut reports = Vec::with_capacity(self.settings.load_steps);
+        while self.step < self.settings.load_steps {
+            match self.step() {
+                Ok(r) => reports.push(r),
+                Err(e) => return Err((reports, e)),
+            }
+        }
+        Ok(reports)
+    }
+}

@@ -1,0 +1,125 @@
+//! Full Newton–Raphson on the out-of-balance force of one load step (eqs 21–23).
+
+use crate::error::{require_count, require_positive, InputError, StepFailure};
+use serde::{Deserialize, Serialize};
+
+/// Newton settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NewtonSettings {
+    /// Converged when ‖f_int − f_ext‖ / ‖f_ext‖ falls below this.
+    pub tolerance: f64,
+    /// Most Newton iterations (linear solves) per load step.
+    pub max_iterations: usize,
+}
+
+impl Default for NewtonSettings {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-9,
+            max_iterations: 30,
+        }
+    }
+}
+
+impl NewtonSettings {
+    pub fn validate(&self) -> Result<(), InputError> {
+        require_positive("newton.tolerance", self.tolerance)?;
+        if self.tolerance >= 1.0 {
+            return Err(InputError::new(
+                "newton.tolerance",
+                self.tolerance,
+                "must lie in (0, 1)",
+            ));
+        }
+        require_count("newton.max_iterations", self.max_iterations, 1)
+    }
+}
+
+/// A discrete nonlinear system `r(u) = f_int(u) − f_ext = 0` with its tangent.
+///
+/// Evaluation order: [`NonlinearSystem::solve_tangent`] is called only after
+/// [`NonlinearSystem::evaluate`] at the same `u`, so the tangent may be formed there.
+pub trait NonlinearSystem {
+    /// Number of unknowns.
+    fn len(&self) -> usize;
+    /// Residual at `u` (and the tangent for the next solve).
+    fn evaluate(&mut self, u: &[f64], residual: &mut [f64]) -> Result<(), StepFailure>;
+    /// Solve `K x = rhs` in place with the tangent formed at the last `evaluate`.
+    fn solve_tangent(&mut self, rhs: &mut [f64]) -> Result<(), StepFailure>;
+    /// Norm used to normalise the residual (‖f_ext‖).
+    fn reference_norm(&self) -> f64;
+}
+
+/// The residual history of a converged solve.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NewtonReport {
+    /// Normalised out-of-balance force: entry 0 before the first solve, entry k after the
+    /// k-th Newton update.
+    pub residuals: Vec<f64>,
+}
+
+impl NewtonReport {
+    /// Number of linear solves performed.
+    pub fn iterations(&self) -> usize {
+        self.residuals.len() - 1
+    }
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// Solve `r(u) = 0` starting from `u`. On failure returns the reason and the residual history.
+pub fn solve(
+    system: &mut dyn NonlinearSystem,
+    u: &mut [f64],
+    settings: &NewtonSettings,
+) -> Result<NewtonReport, (StepFailure, Vec<f64>)> {
+    let n = system.len();
+    let mut r = vec![0.0; n];
+    let mut history = Vec::with_capacity(settings.max_iterations + 1);
+    let scale = system.reference_norm();
+    let scale = if scale > 0.0 && scale.is_finite() {
+        scale
+    } else {
+        1.0
+    };
+    for it in 0..=settings.max_iterations {
+        if let Err(f) = system.evaluate(u, &mut r) {
+            return Err((f, history));
+        }
+        let res = norm(&r) / scale;
+        if !res.is_finite() {
+            return Err((StepFailure::NonFinite { iteration: it }, history));
+        }
+        history.push(res);
+        if res <= settings.tolerance {
+            return Ok(NewtonReport { residuals: history });
+        }
+        if it == settings.max_iterations {
+            break;
+        }
+        // K δ = −r, eq (22); Δd += δ, eq (23).
+        r.iter_mut().for_each(|x| *x = -*x);
+        if let Err(f) = system.solve_tangent(&mut r) {
+            return Err((f, history));
+        }
+        for (ui, di) in u.iter_mut().zip(&r) {
+            *ui += di;
+        }
+    }
+    let last = *history.last().unwrap_or(&f64::NAN);
+    Err((
+        StepFailure::NotConverged {
+            iterations: settings.max_iterations,
+            last,
+        },
+        history,
+    ))
+}
+
+/// Observed convergence order from three successive residuals, ln(r3/r2)/ln(r2/r1).
+pub fn observed_order(r1: f64, r2: f64, r3: f64) -> f64 {
+    (r3 / r2).ln() / (r2 / r1).ln()
+}

@@ -1,0 +1,131 @@
+//! Material points: position, influence domain, volume, mass and the committed
+//! deformation/constitutive state, stored as structure-of-arrays.
+
+use crate::error::{require_count, require_positive, InputError};
+use crate::grid::Grid;
+use crate::kinematics::PointState;
+use nalgebra::SVector;
+
+/// A set of material points in `D` dimensions.
+#[derive(Debug, Clone, Default)]
+pub struct MaterialPoints<const D: usize> {
+    /// Current position x_p.
+    pub position: Vec<SVector<f64, D>>,
+    /// Initial position X_p.
+    pub position0: Vec<SVector<f64, D>>,
+    /// Initial domain half-lengths l_p0 / 2.
+    pub half_length0: Vec<SVector<f64, D>>,
+    /// Current domain half-lengths l_p / 2, updated at the end of each step (eqs 37, 39).
+    pub half_length: Vec<SVector<f64, D>>,
+    /// Initial volume v_p0.
+    pub volume0: Vec<f64>,
+    /// Mass ρ0 v_p0.
+    pub mass: Vec<f64>,
+    /// Committed F, current volume and constitutive state.
+    pub state: Vec<PointState>,
+}
+
+impl<const D: usize> MaterialPoints<D> {
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+
+    /// Add one point with domain half-lengths `half` and density `density`.
+    pub fn push(&mut self, x: SVector<f64, D>, half: SVector<f64, D>, density: f64) {
+        let vol: f64 = half.iter().map(|h| 2.0 * h).product();
+        self.position.push(x);
+        self.position0.push(x);
+        self.half_length0.push(half);
+        self.half_length.push(half);
+        self.volume0.push(vol);
+        self.mass.push(density * vol);
+        self.state.push(PointState::undeformed(vol));
+    }
+
+    /// Fill the box `[lower, upper]` with a regular lattice whose spacing is the grid spacing
+    /// divided by `per_cell[a]` along axis `a`, every point's domain covering its lattice cell
+    /// (no gaps or overlaps, paper §4). The box must be inside the grid and its sides must be
+    /// whole multiples of that spacing.
+    pub fn fill_box(
+        grid: &Grid<D>,
+        lower: [f64; D],
+        upper: [f64; D],
+        per_cell: [usize; D],
+        density: f64,
+    ) -> Result<Self, InputError> {
+        require_positive("material.density", density)?;
+        let mut counts = [0usize; D];
+        let mut step = [0.0; D];
+        for a in 0..D {
+            require_count(&format!("points_per_cell[{a}]"), per_cell[a], 1)?;
+            if per_cell[a] > 64 {
+                return Err(InputError::new(
+                    format!("points_per_cell[{a}]"),
+                    per_cell[a],
+                    "must be <= 64",
+                ));
+            }
+            let len = upper[a] - lower[a];
+            if !(len.is_finite() && len > 0.0) {
+                return Err(InputError::new(
+                    format!("material.upper[{a}]"),
+                    upper[a],
+                    format!("must be finite and > material.lower[{a}] = {}", lower[a]),
+                ));
+            }
+            if lower[a] < grid.origin()[a] - 1e-12 || upper[a] > grid.upper(a) + 1e-12 {
+                return Err(InputError::new(
+                    format!("material box along axis {a}"),
+                    format!("[{}, {}]", lower[a], upper[a]),
+                    format!(
+                        "must lie inside the grid [{}, {}]",
+                        grid.origin()[a],
+                        grid.upper(a)
+                    ),
+                ));
+            }
+            step[a] = grid.spacing()[a] / per_cell[a] as f64;
+            let n = len / step[a];
+            if (n - n.round()).abs() > 1e-8 * n.max(1.0) || n.round() < 1.0 {
+                return Err(InputError::new(
+                    format!("material box along axis {a}"),
+                    format!("[{}, {}]", lower[a], upper[a]),
+                    format!(
+                        "length must be a whole multiple of spacing/points_per_cell = {}",
+                        step[a]
+                    ),
+                ));
+            }
+            counts[a] = n.round() as usize;
+        }
+        let total: usize = counts.iter().product();
+        if total > 20_000_000 {
+            return Err(InputError::new(
+                "number of material points",
+                total,
+                "must be <= 20000000",
+            ));
+        }
+        let mut pts = Self::default();
+        let half = SVector::<f64, D>::from_fn(|a, _| 0.5 * step[a]);
+        for flat in 0..total {
+            let mut rest = flat;
+            let mut x = SVector::<f64, D>::zeros();
+            for a in 0..D {
+                let i = rest % counts[a];
+                rest /= counts[a];
+                x[a] = lower[a] + (i as f64 + 0.5) * step[a];
+            }
+            pts.push(x, half, density);
+        }
+        Ok(pts)
+    }
+
+    /// Displacement of point `p` since the start of the analysis.
+    pub fn displacement(&self, p: usize) -> SVector<f64, D> {
+        self.position[p] - self.position0[p]
+    }
+}

@@ -1,0 +1,3 @@
+//! The paper's examples as problem definitions with their analytical references.
+
+pub mod column;

@@ -1,0 +1,49 @@
+//! Fourth-order tensors on 3×3 matrices stored as 9×9 matrices: entry `(3i+j, 3k+l)` is
+//! `A_ijkl`, so `A : X` is a matrix–vector product on the row-major flattening of `X`.
+
+use nalgebra::{Matrix3, SMatrix, SVector};
+
+/// A fourth-order tensor `A_ijkl` as a 9×9 matrix.
+pub type Tensor4 = SMatrix<f64, 9, 9>;
+
+/// Row index of component `(i, j)` in a [`Tensor4`].
+#[inline(always)]
+pub const fn ij(i: usize, j: usize) -> usize {
+    3 * i + j
+}
+
+/// Row-major flattening of a 3×3 matrix.
+#[inline]
+pub fn flatten(m: &Matrix3<f64>) -> SVector<f64, 9> {
+    SVector::<f64, 9>::from_fn(|r, _| m[(r / 3, r % 3)])
+}
+
+/// Inverse of [`flatten`].
+#[inline]
+pub fn unflatten(v: &SVector<f64, 9>) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| v[ij(i, j)])
+}
+
+/// `A : X` for a fourth-order `A` and second-order `X`.
+#[inline]
+pub fn contract(a: &Tensor4, x: &Matrix3<f64>) -> Matrix3<f64> {
+    unflatten(&(a * flatten(x)))
+}
+
+/// Symmetric fourth-order identity `½(δ_ik δ_jl + δ_il δ_jk)`.
+pub fn identity_sym() -> Tensor4 {
+    Tensor4::from_fn(|r, c| {
+        let (i, j, k, l) = (r / 3, r % 3, c / 3, c % 3);
+        0.5 * (((i == k) && (j == l)) as u8 as f64 + ((i == l) && (j == k)) as u8 as f64)
+    })
+}
+
+/// `δ_ij δ_kl`.
+pub fn identity_outer() -> Tensor4 {
+    Tensor4::from_fn(|r, c| ((r / 3 == r % 3) && (c / 3 == c % 3)) as u8 as f64)
+}
+
+/// Outer product `A_ij B_kl`.
+pub fn outer(a: &Matrix3<f64>, b: &Matrix3<f64>) -> Tensor4 {
+    flatten(a) * flatten(b).transpose()
+}
