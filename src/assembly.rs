@@ -219,18 +219,15 @@ pub struct LoadStepSystem<'a, const D: usize> {
     pub trials: &'a mut Vec<Option<PointTrial<D>>>,
     /// Nodal displacement increment at the last evaluation.
     pub du_nodal: &'a mut Vec<f64>,
-    /// Form the tangent during `evaluate`.
-    pub with_tangent: bool,
 }
 
 impl<const D: usize> LoadStepSystem<'_, D> {
     /// Evaluate all points at the nodal increment and assemble the internal force (in
-    /// equation order) and, if requested, the tangent.
-    pub fn assemble(&mut self, f_int: &mut [f64]) -> Result<(), StepFailure> {
+    /// equation order).
+    pub fn assemble_residual(&mut self, f_int: &mut [f64]) -> Result<(), StepFailure> {
         let model = self.model;
         let table = self.table;
         let du = &*self.du_nodal;
-        let with_tangent = self.with_tangent;
         self.trials.resize(self.states.len(), None);
         let first_error = self
             .trials
@@ -239,7 +236,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             .enumerate()
             .map(|(p, (slot, state))| {
                 let grad = table.gradient(p, du);
-                match evaluate_point::<D>(model, state, &grad, with_tangent) {
+                match evaluate_point::<D>(model, state, &grad) {
                     Ok(t) => {
                         *slot = Some(t);
                         None
@@ -262,23 +259,11 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             return Err(StepFailure::Kinematics { point, reason });
         }
         f_int.iter_mut().for_each(|v| *v = 0.0);
-        if with_tangent {
-            self.matrix.clear_values();
-        }
         let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
         let mut eqs = [None; MAX_POINT_NODES * 3];
         for p in 0..self.states.len() {
             let t = self.trials[p].as_ref().expect("evaluated");
-            let (nodes, _, g) = table.point(p);
-            let m = nodes.len();
-            // ∂S/∂x_j = ∂S/∂X̃_i (ΔF⁻¹)_ij, eq (36).
-            let inv_t = t.delta_f_inv.transpose();
-            for k in 0..m {
-                gx[k] = inv_t * g[k];
-                for i in 0..D {
-                    eqs[k * D + i] = self.dofs.eq(nodes[k] * D + i);
-                }
-            }
+            let m = self.spatial_gradients(p, t, &mut gx, &mut eqs);
             let v = t.volume;
             for k in 0..m {
                 for i in 0..D {
@@ -291,54 +276,86 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                     }
                 }
             }
-            if let (true, Some(a)) = (with_tangent, t.tangent.as_ref()) {
-                // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V, eq (27).
-                for kb in 0..m {
-                    for k in 0..D {
-                        let Some(col) = eqs[kb * D + k] else { continue };
-                        // c_ij = Σ_l a_ijkl g_b,l
-                        let mut c = [[0.0; 3]; 3];
-                        for i in 0..D {
-                            for j in 0..D {
-                                let mut s = 0.0;
-                                for l in 0..D {
-                                    s += a[(ij(i, j), ij(k, l))] * gx[kb][l];
-                                }
-                                c[i][j] = s * v;
+        }
+        Ok(())
+    }
+
+    /// ∂S/∂x_j = ∂S/∂X̃_i (ΔF⁻¹)_ij (eq 36) and the equation numbers of point `p`'s nodes.
+    #[inline]
+    fn spatial_gradients(
+        &self,
+        p: usize,
+        t: &PointTrial<D>,
+        gx: &mut [SVector<f64, D>; MAX_POINT_NODES],
+        eqs: &mut [Option<usize>; MAX_POINT_NODES * 3],
+    ) -> usize {
+        let (nodes, _, g) = self.table.point(p);
+        let inv_t = t.delta_f_inv.transpose();
+        for k in 0..nodes.len() {
+            gx[k] = inv_t * g[k];
+            for i in 0..D {
+                eqs[k * D + i] = self.dofs.eq(nodes[k] * D + i);
+            }
+        }
+        nodes.len()
+    }
+
+    /// Assemble the tangent K = Σ_p [G]ᵀ[a][G] V_p (eq 27) at the trial states of the last
+    /// [`Self::assemble_residual`].
+    pub fn assemble_tangent(&mut self) {
+        self.matrix.clear_values();
+        let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
+        let mut eqs = [None; MAX_POINT_NODES * 3];
+        for p in 0..self.states.len() {
+            let t = self.trials[p].as_ref().expect("evaluated");
+            let m = self.spatial_gradients(p, t, &mut gx, &mut eqs);
+            let a = t.spatial_tangent();
+            let v = t.volume;
+            // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V.
+            for kb in 0..m {
+                for k in 0..D {
+                    let Some(col) = eqs[kb * D + k] else { continue };
+                    let mut c = [[0.0; 3]; 3];
+                    for i in 0..D {
+                        for j in 0..D {
+                            let mut s = 0.0;
+                            for l in 0..D {
+                                s += a[(ij(i, j), ij(k, l))] * gx[kb][l];
                             }
+                            c[i][j] = s * v;
                         }
-                        for ka in 0..m {
-                            for i in 0..D {
-                                let Some(row) = eqs[ka * D + i] else { continue };
-                                let mut s = 0.0;
-                                for j in 0..D {
-                                    s += gx[ka][j] * c[i][j];
-                                }
-                                self.matrix.add(row, col, s);
+                    }
+                    for ka in 0..m {
+                        for i in 0..D {
+                            let Some(row) = eqs[ka * D + i] else { continue };
+                            let mut s = 0.0;
+                            for j in 0..D {
+                                s += gx[ka][j] * c[i][j];
                             }
+                            self.matrix.add(row, col, s);
                         }
                     }
                 }
             }
         }
-        Ok(())
     }
 }
 
 impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
-    fn len(&self) -> usize {
+    fn num_unknowns(&self) -> usize {
         self.dofs.len()
     }
     fn evaluate(&mut self, u: &[f64], residual: &mut [f64]) -> Result<(), StepFailure> {
         self.du_nodal.resize(self.dofs.num_dofs(), 0.0);
         self.dofs.expand(u, self.du_nodal);
-        self.assemble(residual)?;
+        self.assemble_residual(residual)?;
         for (r, f) in residual.iter_mut().zip(self.f_ext) {
             *r -= f;
         }
         Ok(())
     }
     fn solve_tangent(&mut self, rhs: &mut [f64]) -> Result<(), StepFailure> {
+        self.assemble_tangent();
         self.matrix.solve_in_place(rhs).map_err(StepFailure::Singular)
     }
     fn reference_norm(&self) -> f64 {

@@ -83,19 +83,33 @@ pub fn gimp_element_weights(xi_p: f64, l_local: f64, l_global: f64) -> (f64, f64
     (s_a, s_b, ds_a, ds_b)
 }
 
+/// One axis of a background grid.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridAxis {
+    /// Which axis (for error messages).
+    pub axis: usize,
+    pub origin: f64,
+    /// Element size h.
+    pub spacing: f64,
+    pub cells: usize,
+}
+
 impl Basis {
-    /// Weights along one axis of a grid with `origin`, `spacing`, `cells`, for a point at `x`
-    /// whose domain half-length is `r` (ignored by MPM).
+    /// Weights along one grid axis for a point at `x` whose domain half-length is `r`
+    /// (ignored by MPM).
     pub fn axis_weights(
         self,
-        origin: f64,
-        h: f64,
-        cells: usize,
-        axis: usize,
+        grid_axis: GridAxis,
         x: f64,
         r: f64,
         out: &mut AxisWeights,
     ) -> Result<(), BasisError> {
+        let GridAxis {
+            axis,
+            origin,
+            spacing: h,
+            cells,
+        } = grid_axis;
         *out = AxisWeights::default();
         match self {
             Basis::Mpm => {
@@ -166,7 +180,13 @@ impl Basis {
     ) -> Result<(), BasisError> {
         let (o, h, c) = (grid.origin(), grid.spacing(), grid.cells());
         for a in 0..D {
-            self.axis_weights(o[a], h[a], c[a], a, x[a], r[a], &mut out.axes[a])?;
+            let ga = GridAxis {
+                axis: a,
+                origin: o[a],
+                spacing: h[a],
+                cells: c[a],
+            };
+            self.axis_weights(ga, x[a], r[a], &mut out.axes[a])?;
         }
         Ok(())
     }

@@ -23,6 +23,10 @@
 //! | V_p, V_p^n | `PointTrial::volume`, `PointState::volume` |
 //! | l_p | `MaterialPoints::half_length` (half of l_p) |
 
+// Tensor kernels index several arrays with the same component indices; iterator forms would
+// obscure the index notation of the paper.
+#![allow(clippy::needless_range_loop)]
+
 pub mod assembly;
 pub mod basis;
 pub mod constitutive;

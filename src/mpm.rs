@@ -215,7 +215,6 @@ impl<const D: usize> MpmSolver<D> {
                 matrix: &mut self.matrix,
                 trials: &mut self.trials,
                 du_nodal: &mut self.du_nodal,
-                with_tangent: true,
             };
             newton::solve(&mut system, &mut u, &self.settings.newton).map_err(|(f, r)| fail(f, r))?
         };

@@ -42,7 +42,7 @@ impl NewtonSettings {
 /// [`NonlinearSystem::evaluate`] at the same `u`, so the tangent may be formed there.
 pub trait NonlinearSystem {
     /// Number of unknowns.
-    fn len(&self) -> usize;
+    fn num_unknowns(&self) -> usize;
     /// Residual at `u` (and the tangent for the next solve).
     fn evaluate(&mut self, u: &[f64], residual: &mut [f64]) -> Result<(), StepFailure>;
     /// Solve `K x = rhs` in place with the tangent formed at the last `evaluate`.
@@ -76,7 +76,7 @@ pub fn solve(
     u: &mut [f64],
     settings: &NewtonSettings,
 ) -> Result<NewtonReport, (StepFailure, Vec<f64>)> {
-    let n = system.len();
+    let n = system.num_unknowns();
     let mut r = vec![0.0; n];
     let mut history = Vec::with_capacity(settings.max_iterations + 1);
     let scale = system.reference_norm();
@@ -122,4 +122,72 @@ pub fn solve(
 /// Observed convergence order from three successive residuals, ln(r3/r2)/ln(r2/r1).
 pub fn observed_order(r1: f64, r2: f64, r3: f64) -> f64 {
     (r3 / r2).ln() / (r2 / r1).ln()
+}
+
+/// What [`check_quadratic`] verified.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuadraticCheck {
+    /// Number of pairs (r_k, r_{k+1}) tested against r_{k+1} ≤ C r_k².
+    pub ratio_checks: usize,
+    /// Number of triples whose observed order was tested.
+    pub order_checks: usize,
+    /// Largest r_{k+1} / r_k² seen.
+    pub max_ratio: f64,
+    /// Smallest observed order seen (∞ if none).
+    pub min_order: f64,
+}
+
+/// Assert asymptotic quadratic convergence from a residual history (entry 0, before the first
+/// solve, is excluded). Once `r_k ≤ small`, each next residual above `floor` (round-off) must
+/// satisfy `r_{k+1} ≤ c r_k²`; where three successive residuals qualify, the observed order
+/// `ln(r3/r2)/ln(r2/r1)` must be at least `min_order`. Returns what was checked, or a message
+/// naming the first violation.
+pub fn check_quadratic(
+    residuals: &[f64],
+    small: f64,
+    floor: f64,
+    c: f64,
+    min_order: f64,
+) -> Result<QuadraticCheck, String> {
+    let r = if residuals.len() > 1 {
+        &residuals[1..]
+    } else {
+        &[][..]
+    };
+    let mut out = QuadraticCheck {
+        ratio_checks: 0,
+        order_checks: 0,
+        max_ratio: 0.0,
+        min_order: f64::INFINITY,
+    };
+    for k in 0..r.len().saturating_sub(1) {
+        if r[k] <= small && r[k + 1] > floor {
+            let ratio = r[k + 1] / (r[k] * r[k]);
+            out.ratio_checks += 1;
+            out.max_ratio = out.max_ratio.max(ratio);
+            if ratio > c {
+                return Err(format!(
+                    "r_{} = {:.3e} > {c} * r_{}^2 = {:.3e} (history {residuals:?})",
+                    k + 2,
+                    r[k + 1],
+                    k + 1,
+                    c * r[k] * r[k]
+                ));
+            }
+            if k + 2 < r.len() && r[k + 2] > floor {
+                let order = observed_order(r[k], r[k + 1], r[k + 2]);
+                out.order_checks += 1;
+                out.min_order = out.min_order.min(order);
+                if order < min_order {
+                    return Err(format!(
+                        "observed order {order:.3} < {min_order} from residuals {:.3e}, {:.3e}, {:.3e}",
+                        r[k],
+                        r[k + 1],
+                        r[k + 2]
+                    ));
+                }
+            }
+        }
+    }
+    Ok(out)
 }
