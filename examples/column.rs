@@ -6,9 +6,11 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let elements = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(256);
     let weight = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(400_000.0);
+    let yield_stress = args.get(3).and_then(|s| s.parse().ok());
     let spec = ColumnSpec {
         elements,
         weight,
+        yield_stress,
         ..ColumnSpec::default()
     };
     let exact = spec.analytical();
@@ -17,6 +19,12 @@ fn main() {
         exact.displacement(spec.length),
         exact.deformation_gradient(0.0)
     );
+    if let Some(z) = exact.yield_height() {
+        println!(
+            "analytical yield height {z:.6}, base lateral stress {:.3}",
+            exact.lateral_stress(0.0)
+        );
+    }
     for method in [Method::Igimp, Method::Mpm] {
         let t = std::time::Instant::now();
         match solve_column(&spec, method) {

@@ -9,8 +9,10 @@
 //! happens in the solver after Newton converges.
 
 mod linear_elastic;
+mod von_mises;
 
-pub use linear_elastic::LinearElastic;
+pub use linear_elastic::{lame, LinearElastic};
+pub use von_mises::VonMises;
 
 use crate::error::InputError;
 use crate::tensor::Tensor4;
@@ -72,6 +74,12 @@ pub trait ConstitutiveModel: Send + Sync {
 pub enum Material {
     /// Linear elasticity in principal logarithmic strain (Hencky), eq (14).
     LinearElastic { young_modulus: f64, poisson_ratio: f64 },
+    /// Von Mises perfect plasticity on the Kirchhoff stress, eqs (48)–(49).
+    VonMises {
+        young_modulus: f64,
+        poisson_ratio: f64,
+        yield_stress: f64,
+    },
 }
 
 impl Material {
@@ -82,6 +90,15 @@ impl Material {
                 young_modulus,
                 poisson_ratio,
             } => Ok(Box::new(LinearElastic::try_new(young_modulus, poisson_ratio)?)),
+            Material::VonMises {
+                young_modulus,
+                poisson_ratio,
+                yield_stress,
+            } => Ok(Box::new(VonMises::try_new(
+                young_modulus,
+                poisson_ratio,
+                yield_stress,
+            )?)),
         }
     }
 }

@@ -5,7 +5,7 @@
 //! (uniaxial strain).
 
 use crate::basis::Basis;
-use crate::constitutive::LinearElastic;
+use crate::constitutive::{lame, ConstitutiveModel, LinearElastic, VonMises};
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::grid::Grid;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, StepReport};
@@ -15,44 +15,199 @@ use crate::particles::MaterialPoints;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
-/// Analytical solution of the elastic column, eqs (42)–(45).
+/// Analytical solution of the column under self weight, elastic (eqs 42–45) and von Mises
+/// elasto-plastic (eqs 48–54, Appendix A), derived here for any ν (the paper takes ν = 0).
 ///
-/// Equilibrium in the Lagrangian coordinate Z gives the Cauchy stress exactly,
-/// σ(Z) = −ρ0 g (L0 − Z) (eq 42, compression negative). With τ = E ln F (eq 44) and σ = τ/F
-/// (eq 16, J = F in uniaxial strain), F(Z) solves E ln F / F = σ(Z) (eq 45). The displacement
-/// u(Z) = ∫₀^Z (F − 1) dZ' has a closed form after substituting dZ = dσ/(ρ0 g) and
-/// dσ = E (1 − ln F)/F² dF:
+/// **Equilibrium.** In the Lagrangian coordinate Z the vertical Cauchy stress is exact and
+/// independent of the material: σ_zz(Z) = −ρ0 g (L0 − Z) (eq 42, compression negative).
 ///
-/// u(Z) = (E / ρ0 g) [H(F(Z)) − H(F(0))],  H(F) = ln F − ½ ln² F − ln F / F.
+/// **Kinematics.** F = diag(F, 1, 1) (lateral stretches fixed), J = F, total log strains
+/// ε_zz = ln F = y, ε_xx = 0. Cauchy stress σ = τ / F (eq 16).
+///
+/// **Elastic** (Hencky, eq 14, Lamé λ, μ; M = λ + 2μ): τ_zz = M y, τ_xx = λ y. With ν = 0,
+/// M = E and σ = E ln F / F is eq (45).
+///
+/// **Yield** (ρ = |τ_xx − τ_zz| = 2μ|y|, eq 50): at y_y = −ρ_y/(2μ), i.e. when the *Kirchhoff*
+/// stress τ_zz reaches −M ρ_y/(2μ) (= −ρ_y for ν = 0). The Cauchy stress there is
+/// τ_zz/F = −ρ_y e^{ρ_y/E} (ν = 0), so yield starts at Z_y = L0 − ρ_y e^{ρ_y/E}/(ρ0 g), not at
+/// the paper's L0 − ρ_y/(ρ0 g), which equates the Cauchy stress with ρ_y.
+///
+/// **Plastic.** Associated flow gives ε^p_xx = −½ ε^p_zz (deviatoric direction diag(1, −½, −½),
+/// proportional loading). Elastic strains ε^e_xx = ½ε^p_zz and ε^e_zz = y − ε^p_zz on the yield
+/// surface τ_xx − τ_zz = 2μ(ε^e_xx − ε^e_zz) = ρ_y give ε^p_zz = ⅔(y + ρ_y/(2μ)); with
+/// K = λ + ⅔μ and tr ε^e = y (plastic incompressibility):
+///   τ_zz = K y − ⅔ ρ_y,   τ_xx = K y + ⅓ ρ_y.
+/// For ν = 0 (K = E/3) this is the paper's eq (53): with F^e_zz = exp(ε^e_zz),
+/// F = (F^e_zz)³ e^{2ρ_y/E} and σ_zz = E ln F^e_zz / ((F^e_zz)³ e^{2ρ_y/E}); and eq (54),
+/// σ_xx = E ln F^e_xx / F_zz. Appendix A's (A.17) divides by F^e_zz instead of J = F_zz, which
+/// is inconsistent with eq (16); see reference/README.md.
+///
+/// F(Z) solves τ_zz(ln F)/F = σ_zz(Z): τ_zz(y) e^{−y} is increasing for y < 0, so the root is
+/// unique and is found by safeguarded Newton in y.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ElasticColumn {
-    pub young_modulus: f64,
+pub struct AnalyticalColumn {
+    /// Lamé λ.
+    pub lambda: f64,
+    /// Shear modulus μ.
+    pub mu: f64,
     /// ρ0 g, the weight per unit initial volume.
     pub unit_weight: f64,
     pub length: f64,
+    /// Von Mises yield stress ρ_y; `None` for an elastic column.
+    pub yield_stress: Option<f64>,
 }
 
-impl ElasticColumn {
-    /// Cauchy stress at initial height Z, eq (42).
+impl AnalyticalColumn {
+    /// Vertical Cauchy stress at initial height Z, eq (42).
     pub fn stress(&self, z0: f64) -> f64 {
         -self.unit_weight * (self.length - z0)
     }
 
-    /// F at initial height Z: the root of E ln F / F = σ(Z), eq (45).
-    pub fn deformation_gradient(&self, z0: f64) -> f64 {
-        f_from_cauchy_stress(self.stress(z0) / self.young_modulus)
+    /// Log strain at first yield (−ρ_y/2μ), or −∞ when elastic.
+    fn yield_strain(&self) -> f64 {
+        self.yield_stress
+            .map_or(f64::NEG_INFINITY, |ry| -ry / (2.0 * self.mu))
     }
 
-    /// Displacement at initial height Z.
+    /// Kirchhoff stresses (τ_zz, τ_xx) at vertical log strain y ≤ 0.
+    pub fn kirchhoff(&self, y: f64) -> (f64, f64) {
+        if y >= self.yield_strain() {
+            ((self.lambda + 2.0 * self.mu) * y, self.lambda * y)
+        } else {
+            let ry = self.yield_stress.expect("plastic branch");
+            let k = self.lambda + 2.0 * self.mu / 3.0;
+            (k * y - 2.0 * ry / 3.0, k * y + ry / 3.0)
+        }
+    }
+
+    /// F at initial height Z: the root of τ_zz(ln F)/F = σ_zz(Z).
+    pub fn deformation_gradient(&self, z0: f64) -> f64 {
+        let sigma = self.stress(z0);
+        if sigma >= 0.0 {
+            return 1.0;
+        }
+        let m = self.lambda + 2.0 * self.mu;
+        if self.yield_stress.is_none() {
+            return f_from_cauchy_stress(sigma / m);
+        }
+        // ψ(y) = τ_zz(y) e^{−y} − σ is increasing on y < 0 with ψ(0) = −σ > 0.
+        let psi = |y: f64| self.kirchhoff(y).0 * (-y).exp() - sigma;
+        let (mut lo, mut hi) = (-1.0, 0.0);
+        while psi(lo) > 0.0 {
+            lo *= 2.0;
+            assert!(lo > -1e6, "no root for column stress {sigma}");
+        }
+        let mut y = 0.5 * (lo + hi);
+        for _ in 0..200 {
+            let v = psi(y);
+            if v > 0.0 {
+                hi = y;
+            } else {
+                lo = y;
+            }
+            let dy = 1e-7 * (1.0 + y.abs());
+            let slope = (psi(y + dy) - psi(y - dy)) / (2.0 * dy);
+            let mut next = y - v / slope;
+            if !(next > lo && next < hi) || !next.is_finite() {
+                next = 0.5 * (lo + hi);
+            }
+            if (next - y).abs() <= 1e-15 * (1.0 + y.abs()) || hi - lo <= 1e-15 {
+                y = next;
+                break;
+            }
+            y = next;
+        }
+        y.exp()
+    }
+
+    /// Lateral Cauchy stress σ_xx = σ_yy at initial height Z.
+    pub fn lateral_stress(&self, z0: f64) -> f64 {
+        let f = self.deformation_gradient(z0);
+        self.kirchhoff(f.ln()).1 / f
+    }
+
+    /// Initial height below which the column is plastic (`None` if it never yields).
+    pub fn yield_height(&self) -> Option<f64> {
+        let y = self.yield_strain();
+        if !y.is_finite() {
+            return None;
+        }
+        let sigma_y = (self.lambda + 2.0 * self.mu) * y / y.exp();
+        let z = self.length + sigma_y / self.unit_weight;
+        (z > 0.0).then_some(z)
+    }
+
+    /// Displacement at initial height Z: closed form when elastic (see
+    /// [`AnalyticalColumn::elastic_displacement`]), 64-point Gauss–Legendre on each smooth
+    /// piece of ∫₀^Z (F − 1) dZ' otherwise.
     pub fn displacement(&self, z0: f64) -> f64 {
+        if self.yield_stress.is_none() {
+            return self.elastic_displacement(z0);
+        }
+        let mut breaks = vec![0.0];
+        if let Some(zy) = self.yield_height() {
+            if zy < z0 {
+                breaks.push(zy);
+            }
+        }
+        breaks.push(z0);
+        let (xs, ws) = gauss_legendre_64();
+        let mut u = 0.0;
+        for w in breaks.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            for (x, wt) in xs.iter().zip(&ws) {
+                let z = 0.5 * (a + b) + 0.5 * (b - a) * x;
+                u += 0.5 * (b - a) * wt * (self.deformation_gradient(z) - 1.0);
+            }
+        }
+        u
+    }
+
+    /// Elastic displacement in closed form: substituting dZ = dσ/(ρ0 g) and
+    /// dσ = M (1 − ln F)/F² dF in u(Z) = ∫₀^Z (F − 1) dZ' gives
+    /// u(Z) = (M / ρ0 g) [H(F(Z)) − H(F(0))],  H(F) = ln F − ½ ln² F − ln F / F.
+    pub fn elastic_displacement(&self, z0: f64) -> f64 {
         let h = |f: f64| {
             let l = f.ln();
             l - 0.5 * l * l - l / f
         };
-        let f0 = self.deformation_gradient(0.0);
-        let fz = self.deformation_gradient(z0);
-        self.young_modulus / self.unit_weight * (h(fz) - h(f0))
+        let m = self.lambda + 2.0 * self.mu;
+        let elastic = Self {
+            yield_stress: None,
+            ..*self
+        };
+        let f0 = elastic.deformation_gradient(0.0);
+        let fz = elastic.deformation_gradient(z0);
+        m / self.unit_weight * (h(fz) - h(f0))
     }
+}
+
+/// 64-point Gauss–Legendre nodes and weights on [−1, 1] (Newton on P_64).
+fn gauss_legendre_64() -> (Vec<f64>, Vec<f64>) {
+    let n = 64;
+    let mut xs = Vec::with_capacity(n);
+    let mut ws = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 0.0;
+        for _ in 0..100 {
+            let (mut p0, mut p1) = (1.0, x);
+            for k in 2..=n {
+                let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                p0 = p1;
+                p1 = p2;
+            }
+            dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+            let dx = p1 / dp;
+            x -= dx;
+            if dx.abs() < 1e-16 {
+                break;
+            }
+        }
+        xs.push(x);
+        ws.push(2.0 / ((1.0 - x * x) * dp * dp));
+    }
+    (xs, ws)
 }
 
 /// Solve ln F / F = s for F (s = σ/E < 1/e, the compressive branch F ≤ 1 when s ≤ 0).
@@ -132,6 +287,9 @@ pub struct ColumnSpec {
     pub points_per_cell: usize,
     pub load_steps: usize,
     pub newton: NewtonSettings,
+    /// Von Mises yield stress ρ_y (eq 48); absent for an elastic column.
+    #[serde(default)]
+    pub yield_stress: Option<f64>,
 }
 
 impl Default for ColumnSpec {
@@ -146,6 +304,7 @@ impl Default for ColumnSpec {
             points_per_cell: 2,
             load_steps: 20,
             newton: NewtonSettings::default(),
+            yield_stress: None,
         }
     }
 }
@@ -171,6 +330,7 @@ impl ColumnSpec {
         }
         require_count("load_steps", self.load_steps, 1)?;
         self.newton.validate()?;
+        self.model()?;
         let s = -self.weight / self.young_modulus;
         if s < -1e3 {
             return Err(InputError::new(
@@ -186,11 +346,29 @@ impl ColumnSpec {
         self.weight / (self.density * self.length)
     }
     /// The analytical solution of this column.
-    pub fn analytical(&self) -> ElasticColumn {
-        ElasticColumn {
-            young_modulus: self.young_modulus,
+    pub fn analytical(&self) -> AnalyticalColumn {
+        let (lambda, mu) = lame(self.young_modulus, self.poisson_ratio);
+        AnalyticalColumn {
+            lambda,
+            mu,
             unit_weight: self.density * self.gravity(),
             length: self.length,
+            yield_stress: self.yield_stress,
+        }
+    }
+
+    /// The constitutive model: linear elastic, or von Mises when `yield_stress` is set.
+    pub fn model(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
+        match self.yield_stress {
+            None => Ok(Box::new(LinearElastic::try_new(
+                self.young_modulus,
+                self.poisson_ratio,
+            )?)),
+            Some(ry) => Ok(Box::new(VonMises::try_new(
+                self.young_modulus,
+                self.poisson_ratio,
+                ry,
+            )?)),
         }
     }
 
@@ -201,7 +379,7 @@ impl ColumnSpec {
         let grid = Grid::try_new([0.0], [h], [self.elements])?;
         let points =
             MaterialPoints::fill_box(&grid, [0.0], [self.length], [self.points_per_cell], self.density)?;
-        let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
+        let model = self.model()?;
         let loads = Loads {
             gravity: SVector::<f64, 1>::new(-self.gravity()),
             point_loads: vec![],
@@ -231,6 +409,8 @@ pub struct PointRecord {
     pub sigma_xx: f64,
     /// Vertical stretch F_zz.
     pub f_zz: f64,
+    /// Accumulated plastic multiplier (0 where the point never yielded).
+    pub plastic_multiplier: f64,
 }
 
 /// Outcome of one column analysis.
@@ -311,6 +491,7 @@ pub fn solve_mpm(spec: &ColumnSpec, basis: Basis) -> Result<ColumnOutcome, Input
                 sigma_zz: sigma[(0, 0)],
                 sigma_xx: sigma[(1, 1)],
                 f_zz: st.f[(0, 0)],
+                plastic_multiplier: st.material.plastic_multiplier,
             }
         })
         .collect();
