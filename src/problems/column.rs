@@ -132,6 +132,10 @@ pub struct ColumnSpec {
     pub points_per_cell: usize,
     pub load_steps: usize,
     pub newton: NewtonSettings,
+    /// Gauss points per element of the FEM comparators, 1..=5 (default: 2 for linear, 3 for
+    /// quadratic elements, as in the paper). Not used by MPM/GIMP.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gauss_points: Option<usize>,
 }
 
 impl Default for ColumnSpec {
@@ -146,6 +150,7 @@ impl Default for ColumnSpec {
             points_per_cell: 2,
             load_steps: 20,
             newton: NewtonSettings::default(),
+            gauss_points: None,
         }
     }
 }
@@ -171,6 +176,9 @@ impl ColumnSpec {
         }
         require_count("load_steps", self.load_steps, 1)?;
         self.newton.validate()?;
+        if let Some(n) = self.gauss_points {
+            crate::quadrature::GaussRule::try_new(n)?;
+        }
         let s = -self.weight / self.young_modulus;
         if s < -1e3 {
             return Err(InputError::new(
