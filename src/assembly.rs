@@ -283,10 +283,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             for k in 0..m {
                 for i in 0..D {
                     if let Some(e) = eqs[k * D + i] {
-                        let mut s = 0.0;
-                        for j in 0..D {
-                            s += t.sigma[(i, j)] * gx[k][j];
-                        }
+                        let s: f64 = (0..D).map(|j| t.sigma[(i, j)] * gx[k][j]).sum();
                         f_int[e] += s * v; // eq (29)
                     }
                 }

@@ -86,6 +86,7 @@ pub fn gimp_element_weights(xi_p: f64, l_local: f64, l_global: f64) -> (f64, f64
 impl Basis {
     /// Weights along one axis of a grid with `origin`, `spacing`, `cells`, for a point at `x`
     /// whose domain half-length is `r` (ignored by MPM).
+    #[allow(clippy::too_many_arguments)] // one scalar per geometric quantity of the axis
     pub fn axis_weights(
         self,
         origin: f64,

@@ -43,6 +43,10 @@ impl NewtonSettings {
 pub trait NonlinearSystem {
     /// Number of unknowns.
     fn len(&self) -> usize;
+    /// True if there are no unknowns.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
     /// Residual at `u` (and the tangent for the next solve).
     fn evaluate(&mut self, u: &[f64], residual: &mut [f64]) -> Result<(), StepFailure>;
     /// Solve `K x = rhs` in place with the tangent formed at the last `evaluate`.
