@@ -3,7 +3,7 @@
 //! comparators (points = Gauss points, supports = element shape functions).
 //!
 //! Each point contributes `f_p = [G]ᵀ{σ} V_p` (eq 29) and `K_p = [G]ᵀ[a][G] V_p` (eq 27),
-//! where [G] holds ∂S/∂x = ∂S/∂X̃ · ΔF⁻¹ (eqs 36, 41). Points are evaluated in parallel into
+//! where \[G\] holds ∂S/∂x = ∂S/∂X̃ · ΔF⁻¹ (eqs 36, 41). Points are evaluated in parallel into
 //! per-point slots; the scatter runs serially in point order, so results do not depend on
 //! the thread count.
 
@@ -268,10 +268,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             for k in 0..m {
                 for i in 0..D {
                     if let Some(e) = eqs[k * D + i] {
-                        let mut s = 0.0;
-                        for j in 0..D {
-                            s += t.sigma[(i, j)] * gx[k][j];
-                        }
+                        let s: f64 = (0..D).map(|j| t.sigma[(i, j)] * gx[k][j]).sum();
                         f_int[e] += s * v; // eq (29)
                     }
                 }
@@ -300,7 +297,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         nodes.len()
     }
 
-    /// Assemble the tangent K = Σ_p [G]ᵀ[a][G] V_p (eq 27) at the trial states of the last
+    /// Assemble the tangent `K = Σ_p [G]ᵀ[a][G] V_p` (eq 27) at the trial states of the last
     /// [`Self::assemble_residual`].
     pub fn assemble_tangent(&mut self) {
         self.matrix.clear_values();

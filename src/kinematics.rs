@@ -83,7 +83,7 @@ fn log_divided_differences(lam: &Vector3<f64>) -> Matrix3<f64> {
 
 /// L_mnpq = ∂ ln(b)_mn / ∂ b_pq (eq 26) by the Daleckii–Krein formula for the derivative of a
 /// symmetric matrix function: `dln(b)[H] = Q (Θ ∘ QᵀHQ) Qᵀ` with `Θ_aa = 1/λ_a` and
-/// `Θ_ab = (ln λ_a − ln λ_b)/(λ_a − λ_b)` (the closed form of Miehe's algorithm, ref [102]).
+/// `Θ_ab = (ln λ_a − ln λ_b)/(λ_a − λ_b)` (the closed form of Miehe's algorithm, paper ref. 102).
 pub fn dlog(lam: &Vector3<f64>, q: &Matrix3<f64>) -> Tensor4 {
     let theta = log_divided_differences(lam);
     let mut l = Tensor4::zeros();

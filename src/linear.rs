@@ -79,9 +79,9 @@ impl SparseSystem {
     /// `y = K x`.
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         y.iter_mut().for_each(|v| *v = 0.0);
-        for c in 0..self.n {
+        for (c, xc) in x.iter().enumerate().take(self.n) {
             for k in self.col_ptr[c]..self.col_ptr[c + 1] {
-                y[self.row_idx[k]] += self.values[k] * x[c];
+                y[self.row_idx[k]] += self.values[k] * xc;
             }
         }
     }

@@ -108,7 +108,7 @@ impl AnalyticalColumn {
             let dy = 1e-7 * (1.0 + y.abs());
             let slope = (psi(y + dy) - psi(y - dy)) / (2.0 * dy);
             let mut next = y - v / slope;
-            if !(next > lo && next < hi) || !next.is_finite() {
+            if !(next > lo && next < hi && next.is_finite()) {
                 next = 0.5 * (lo + hi);
             }
             if (next - y).abs() <= 1e-15 * (1.0 + y.abs()) || hi - lo <= 1e-15 {
@@ -290,6 +290,10 @@ pub struct ColumnSpec {
     /// Von Mises yield stress ρ_y (eq 48); absent for an elastic column.
     #[serde(default)]
     pub yield_stress: Option<f64>,
+    /// Gauss points per element of the FEM comparators, 1..=5 (default: 2 for linear, 3 for
+    /// quadratic elements, as in the paper). Not used by MPM/GIMP.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gauss_points: Option<usize>,
 }
 
 impl Default for ColumnSpec {
@@ -305,6 +309,7 @@ impl Default for ColumnSpec {
             load_steps: 20,
             newton: NewtonSettings::default(),
             yield_stress: None,
+            gauss_points: None,
         }
     }
 }
@@ -331,6 +336,9 @@ impl ColumnSpec {
         require_count("load_steps", self.load_steps, 1)?;
         self.newton.validate()?;
         self.model()?;
+        if let Some(n) = self.gauss_points {
+            crate::quadrature::GaussRule::try_new(n)?;
+        }
         let s = -self.weight / self.young_modulus;
         if s < -1e3 {
             return Err(InputError::new(
