@@ -6,6 +6,7 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use igimp::basis::Basis;
 use igimp::constitutive::LinearElastic;
 use igimp::kinematics::{evaluate_point, PointState};
+use igimp::newton::LoadStepping;
 use igimp::problems::column::ColumnSpec;
 use nalgebra::SMatrix;
 use std::hint::black_box;

@@ -11,7 +11,7 @@ use crate::constitutive::ConstitutiveModel;
 use crate::error::StepFailure;
 use crate::kinematics::{evaluate_point, PointState, PointTrial};
 use crate::linear::SparseSystem;
-use crate::newton::NonlinearSystem;
+use crate::newton::{self, NewtonReport, NewtonSettings, NonlinearSystem};
 use crate::tensor::ij;
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
@@ -357,5 +357,81 @@ impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
     }
     fn reference_norm(&self) -> f64 {
         self.f_ext.iter().map(|x| x * x).sum::<f64>().sqrt()
+    }
+}
+
+/// Per-step storage of a discretisation, reused from step to step so that the hot loops do
+/// not allocate: the supports, the sparse tangent, the trial point states and the nodal
+/// increment. Material point and finite element solvers fill [`StepWorkspace::table`] with
+/// their weights or shape functions and then share everything else.
+#[derive(Debug, Default)]
+pub struct StepWorkspace<const D: usize> {
+    pub table: SupportTable<D>,
+    pub matrix: SparseSystem,
+    pub trials: Vec<Option<PointTrial<D>>>,
+    pub du_nodal: Vec<f64>,
+}
+
+/// What a load step applies, besides the material model and the committed states.
+pub struct StepInput<'a, const D: usize> {
+    pub model: &'a dyn ConstitutiveModel,
+    pub states: &'a [PointState],
+    pub num_nodes: usize,
+    /// Homogeneous Dirichlet conditions (node, axis).
+    pub fixed: &'a [(usize, usize)],
+    /// Force carried by each point (body force × mass, point loads), mapped with the weights (eq 40).
+    pub point_forces: &'a [SVector<f64, D>],
+    /// Forces applied directly to nodal dofs (dof = node·D + axis).
+    pub nodal_forces: &'a [(usize, f64)],
+}
+
+impl<const D: usize> StepWorkspace<D> {
+    /// From the filled [`Self::table`]: the dof map, sparsity pattern (and so a fresh symbolic
+    /// factorisation) and external force of one load step; the resulting system is handed to `f`.
+    pub fn with_system<R>(
+        &mut self,
+        input: &StepInput<'_, D>,
+        f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
+    ) -> R {
+        let dofs = DofMap::build(input.num_nodes, &self.table, input.fixed);
+        self.matrix.set_pattern(dofs.pattern(&self.table));
+        let mut nodal = vec![0.0; dofs.num_dofs()];
+        map_point_forces(&self.table, input.point_forces, &mut nodal);
+        for &(dof, force) in input.nodal_forces {
+            nodal[dof] += force;
+        }
+        let mut f_ext = vec![0.0; dofs.len()];
+        dofs.gather(&nodal, &mut f_ext);
+        let mut system = LoadStepSystem {
+            model: input.model,
+            states: input.states,
+            table: &self.table,
+            dofs: &dofs,
+            f_ext: &f_ext,
+            matrix: &mut self.matrix,
+            trials: &mut self.trials,
+            du_nodal: &mut self.du_nodal,
+        };
+        f(&mut system)
+    }
+
+    /// Newton on one load step from a zero increment. On success [`Self::trials`] and
+    /// [`Self::du_nodal`] hold the converged state for the caller to commit.
+    pub fn solve(
+        &mut self,
+        input: &StepInput<'_, D>,
+        settings: &NewtonSettings,
+    ) -> Result<NewtonReport, (StepFailure, Vec<f64>)> {
+        self.with_system(input, |system| {
+            let mut u = vec![0.0; system.num_unknowns()];
+            newton::solve(system, &mut u, settings)
+        })
+    }
+
+    /// Committed states of the converged step.
+    pub fn committed_states(&self) -> impl Iterator<Item = PointState> + '_ {
+        self.trials
+            .iter()
+            .map(|t| t.as_ref().expect("converged trial").committed())
     }
 }

@@ -1,13 +1,12 @@
 //! The implicit material point solver: load-step loop, Newton solve and commit (Figures 6–7).
 
-use crate::assembly::{map_point_forces, DofMap, LoadStepSystem, SupportTable};
+use crate::assembly::{StepInput, StepWorkspace, SupportTable};
 use crate::basis::{Basis, Support};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, InputError, SolveError, StepFailure};
 use crate::grid::Grid;
-use crate::kinematics::{stretch_tensor, PointTrial};
-use crate::linear::SparseSystem;
-use crate::newton::{self, NewtonReport, NewtonSettings};
+use crate::kinematics::stretch_tensor;
+use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::particles::MaterialPoints;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
@@ -59,15 +58,6 @@ pub struct Loads<const D: usize> {
     pub point_loads: Vec<(usize, SVector<f64, D>)>,
 }
 
-/// What one converged load step did.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StepReport {
-    /// Load step number, from 1.
-    pub step: usize,
-    pub load_factor: f64,
-    pub newton: NewtonReport,
-}
-
 /// Implicit MPM / GIMP solver for `D` dimensions.
 pub struct MpmSolver<const D: usize> {
     pub grid: Grid<D>,
@@ -78,10 +68,7 @@ pub struct MpmSolver<const D: usize> {
     pub loads: Loads<D>,
     pub settings: MpmSettings,
     step: usize,
-    table: SupportTable<D>,
-    matrix: SparseSystem,
-    trials: Vec<Option<PointTrial<D>>>,
-    du_nodal: Vec<f64>,
+    work: StepWorkspace<D>,
 }
 
 impl<const D: usize> MpmSolver<D> {
@@ -139,16 +126,8 @@ impl<const D: usize> MpmSolver<D> {
             loads,
             settings,
             step: 0,
-            table: SupportTable::default(),
-            matrix: SparseSystem::default(),
-            trials: Vec::new(),
-            du_nodal: Vec::new(),
+            work: StepWorkspace::default(),
         })
-    }
-
-    /// Load steps completed so far.
-    pub fn steps_done(&self) -> usize {
-        self.step
     }
 
     /// The constitutive model.
@@ -159,7 +138,7 @@ impl<const D: usize> MpmSolver<D> {
     /// Evaluate the weights of every point on the grid at the current positions and domains.
     pub fn build_supports(&mut self) -> Result<(), StepFailure> {
         let basis = self.settings.basis;
-        self.table.clear();
+        self.work.table.clear();
         let mut sup = Support::<D>::default();
         for p in 0..self.points.len() {
             basis
@@ -175,56 +154,16 @@ impl<const D: usize> MpmSolver<D> {
                 })?;
             for k in 0..sup.len() {
                 let (node, s, g) = sup.node(&self.grid, k);
-                self.table.push_node(node, s, g);
+                self.work.table.push_node(node, s, g);
             }
-            self.table.finish_point();
+            self.work.table.finish_point();
         }
         Ok(())
     }
 
     /// Supports of the last [`Self::build_supports`].
     pub fn supports(&self) -> &SupportTable<D> {
-        &self.table
-    }
-
-    /// Solve the next load step and commit it.
-    pub fn step(&mut self) -> Result<StepReport, SolveError> {
-        let step = self.step + 1;
-        let fail = |failure, residuals| SolveError {
-            step,
-            failure,
-            residuals,
-        };
-        let load_factor = step as f64 / self.settings.load_steps as f64;
-        self.build_supports().map_err(|f| fail(f, vec![]))?;
-        let dofs = DofMap::build(self.grid.num_nodes(), &self.table, &self.fixed);
-        self.matrix.set_pattern(dofs.pattern(&self.table));
-        let forces: Vec<SVector<f64, D>> = self.external_point_forces(load_factor);
-        let mut nodal = vec![0.0; dofs.num_dofs()];
-        map_point_forces(&self.table, &forces, &mut nodal); // eq (40)
-        let mut f_ext = vec![0.0; dofs.len()];
-        dofs.gather(&nodal, &mut f_ext);
-        let mut u = vec![0.0; dofs.len()];
-        let report = {
-            let mut system = LoadStepSystem {
-                model: self.model.as_ref(),
-                states: &self.points.state,
-                table: &self.table,
-                dofs: &dofs,
-                f_ext: &f_ext,
-                matrix: &mut self.matrix,
-                trials: &mut self.trials,
-                du_nodal: &mut self.du_nodal,
-            };
-            newton::solve(&mut system, &mut u, &self.settings.newton).map_err(|(f, r)| fail(f, r))?
-        };
-        self.commit();
-        self.step = step;
-        Ok(StepReport {
-            step,
-            load_factor,
-            newton: report,
-        })
+        &self.work.table
     }
 
     fn external_point_forces(&self, load_factor: f64) -> Vec<SVector<f64, D>> {
@@ -243,10 +182,10 @@ impl<const D: usize> MpmSolver<D> {
     /// Commit the converged step: states, positions (x += Σ S Δu) and domains (eqs 37/39).
     fn commit(&mut self) {
         for p in 0..self.points.len() {
-            let trial = self.trials[p].as_ref().expect("converged trial");
+            let trial = self.work.trials[p].as_ref().expect("converged trial");
             let new_state = trial.committed();
             self.points.state[p] = new_state;
-            let du = self.table.interpolate(p, &self.du_nodal);
+            let du = self.work.table.interpolate(p, &self.work.du_nodal);
             self.points.position[p] += du;
             let r0 = self.points.half_length0[p];
             let f = new_state.f;
@@ -260,17 +199,43 @@ impl<const D: usize> MpmSolver<D> {
             };
         }
     }
+}
 
-    /// Run all remaining load steps. On failure returns the reports of the converged steps
-    /// and the error.
-    pub fn run(&mut self) -> Result<Vec<StepReport>, (Vec<StepReport>, SolveError)> {
-        let mut reports = Vec::with_capacity(self.settings.load_steps);
-        while self.step < self.settings.load_steps {
-            match self.step() {
-                Ok(r) => reports.push(r),
-                Err(e) => return Err((reports, e)),
-            }
-        }
-        Ok(reports)
+impl<const D: usize> LoadStepping for MpmSolver<D> {
+    fn step(&mut self) -> Result<StepReport, SolveError> {
+        let step = self.step + 1;
+        let fail = |failure, residuals| SolveError {
+            step,
+            failure,
+            residuals,
+        };
+        let load_factor = step as f64 / self.settings.load_steps as f64;
+        self.build_supports().map_err(|f| fail(f, vec![]))?;
+        let forces = self.external_point_forces(load_factor);
+        let input = StepInput {
+            model: self.model.as_ref(),
+            states: &self.points.state,
+            num_nodes: self.grid.num_nodes(),
+            fixed: &self.fixed,
+            point_forces: &forces,
+            nodal_forces: &[],
+        };
+        let report = self
+            .work
+            .solve(&input, &self.settings.newton)
+            .map_err(|(f, r)| fail(f, r))?;
+        self.commit();
+        self.step = step;
+        Ok(StepReport {
+            step,
+            load_factor,
+            newton: report,
+        })
+    }
+    fn steps_done(&self) -> usize {
+        self.step
+    }
+    fn load_steps(&self) -> usize {
+        self.settings.load_steps
     }
 }

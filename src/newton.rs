@@ -1,6 +1,6 @@
 //! Full Newton–Raphson on the out-of-balance force of one load step (eqs 21–23).
 
-use crate::error::{require_count, require_positive, InputError, StepFailure};
+use crate::error::{require_count, require_positive, InputError, SolveError, StepFailure};
 use serde::{Deserialize, Serialize};
 
 /// Newton settings.
@@ -190,4 +190,36 @@ pub fn check_quadratic(
         }
     }
     Ok(out)
+}
+
+/// What one converged load step did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StepReport {
+    /// Load step number, from 1.
+    pub step: usize,
+    pub load_factor: f64,
+    pub newton: NewtonReport,
+}
+
+/// A solver that advances through a fixed number of proportional load steps.
+pub trait LoadStepping {
+    /// Solve and commit the next load step.
+    fn step(&mut self) -> Result<StepReport, SolveError>;
+    /// Load steps completed so far.
+    fn steps_done(&self) -> usize;
+    /// Total number of load steps.
+    fn load_steps(&self) -> usize;
+
+    /// Run all remaining load steps. On failure returns the reports of the converged steps
+    /// and the error; the solver then holds the last converged state.
+    fn run(&mut self) -> Result<Vec<StepReport>, (Vec<StepReport>, SolveError)> {
+        let mut reports = Vec::with_capacity(self.load_steps());
+        while self.steps_done() < self.load_steps() {
+            match self.step() {
+                Ok(r) => reports.push(r),
+                Err(e) => return Err((reports, e)),
+            }
+        }
+        Ok(reports)
+    }
 }

@@ -14,6 +14,7 @@ use igimp::kinematics::{
 };
 use igimp::linear::SparseSystem;
 use igimp::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
+use igimp::newton::LoadStepping;
 use igimp::newton::{NewtonSettings, NonlinearSystem};
 use igimp::particles::MaterialPoints;
 use igimp::problems::column::ColumnSpec;

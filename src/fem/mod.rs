@@ -44,13 +44,11 @@ mod line;
 
 pub use line::{LineElement, LineMesh, MAX_LINE_NODES};
 
-use crate::assembly::{map_point_forces, DofMap, LoadStepSystem, SupportTable};
+use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, require_finite, InputError, SolveError, StepFailure};
-use crate::kinematics::{PointState, PointTrial};
-use crate::linear::SparseSystem;
-use crate::mpm::StepReport;
-use crate::newton::{self, NewtonSettings};
+use crate::kinematics::PointState;
+use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::problems::column::{ColumnOutcome, ColumnSpec, PointRecord};
 use crate::quadrature::GaussRule;
 use nalgebra::SVector;
@@ -130,10 +128,9 @@ pub struct LineFem {
     pub settings: LineFemSettings,
     rule: GaussRule,
     step: usize,
-    table: SupportTable<1>,
-    matrix: SparseSystem,
-    trials: Vec<Option<PointTrial<1>>>,
-    du_nodal: Vec<f64>,
+    /// Nodal dofs fixed at zero, as (node, axis).
+    fixed_dofs: Vec<(usize, usize)>,
+    work: StepWorkspace<1>,
 }
 
 impl LineFem {
@@ -188,21 +185,14 @@ impl LineFem {
             mesh,
             gauss,
             model,
-            fixed,
+            fixed: fixed.clone(),
             loads,
             settings,
             rule,
             step: 0,
-            table: SupportTable::default(),
-            matrix: SparseSystem::default(),
-            trials: Vec::new(),
-            du_nodal: Vec::new(),
+            fixed_dofs: fixed.iter().map(|&n| (n, 0)).collect(),
+            work: StepWorkspace::default(),
         })
-    }
-
-    /// Load steps completed so far.
-    pub fn steps_done(&self) -> usize {
-        self.step
     }
 
     /// The Gauss rule on [−1, 1].
@@ -215,7 +205,7 @@ impl LineFem {
     pub fn build_supports(&mut self) -> Result<(), StepFailure> {
         let element = self.mesh.element;
         let k = element.nodes_per_element();
-        self.table.clear();
+        self.work.table.clear();
         for p in 0..self.gauss.len() {
             let e = self.gauss.element[p];
             let x = self.mesh.element_coordinates(e);
@@ -229,17 +219,18 @@ impl LineFem {
             }
             let first = self.mesh.first_node(e);
             for a in 0..k {
-                self.table
+                self.work
+                    .table
                     .push_node(first + a, n[a], SVector::<f64, 1>::new(dn[a] / jac));
             }
-            self.table.finish_point();
+            self.work.table.finish_point();
         }
         Ok(())
     }
 
     /// Supports of the last [`Self::build_supports`].
     pub fn supports(&self) -> &SupportTable<1> {
-        &self.table
+        &self.work.table
     }
 
     /// Set up the nonlinear system of a load step at `load_factor` on the current mesh and
@@ -251,82 +242,37 @@ impl LineFem {
         f: impl FnOnce(&mut LoadStepSystem<'_, 1>) -> R,
     ) -> Result<R, StepFailure> {
         self.build_supports()?;
-        let fixed: Vec<(usize, usize)> = self.fixed.iter().map(|&n| (n, 0)).collect();
-        let dofs = DofMap::build(self.mesh.num_nodes(), &self.table, &fixed);
-        self.matrix.set_pattern(dofs.pattern(&self.table));
         let forces: Vec<SVector<f64, 1>> = self
             .gauss
             .mass
             .iter()
             .map(|&m| SVector::<f64, 1>::new(m * self.loads.gravity * load_factor))
             .collect();
-        let mut nodal = vec![0.0; dofs.num_dofs()];
-        map_point_forces(&self.table, &forces, &mut nodal); // eq (40)
-        for &(n, force) in &self.loads.nodal_forces {
-            nodal[n] += force * load_factor;
-        }
-        let mut f_ext = vec![0.0; dofs.len()];
-        dofs.gather(&nodal, &mut f_ext);
-        let mut system = LoadStepSystem {
+        let nodal: Vec<(usize, f64)> = self
+            .loads
+            .nodal_forces
+            .iter()
+            .map(|&(n, force)| (n, force * load_factor))
+            .collect();
+        let input = StepInput {
             model: self.model.as_ref(),
             states: &self.gauss.state,
-            table: &self.table,
-            dofs: &dofs,
-            f_ext: &f_ext,
-            matrix: &mut self.matrix,
-            trials: &mut self.trials,
-            du_nodal: &mut self.du_nodal,
+            num_nodes: self.mesh.num_nodes(),
+            fixed: &self.fixed_dofs,
+            point_forces: &forces,
+            nodal_forces: &nodal,
         };
-        Ok(f(&mut system))
-    }
-
-    /// Solve the next load step and commit it.
-    pub fn step(&mut self) -> Result<StepReport, SolveError> {
-        let step = self.step + 1;
-        let fail = |failure, residuals| SolveError {
-            step,
-            failure,
-            residuals,
-        };
-        let load_factor = step as f64 / self.settings.load_steps as f64;
-        let newton_settings = self.settings.newton;
-        let report = self
-            .with_step_system(load_factor, |system| {
-                let mut u = vec![0.0; newton::NonlinearSystem::num_unknowns(system)];
-                newton::solve(system, &mut u, &newton_settings)
-            })
-            .map_err(|f| fail(f, vec![]))?
-            .map_err(|(f, r)| fail(f, r))?;
-        self.commit();
-        self.step = step;
-        Ok(StepReport {
-            step,
-            load_factor,
-            newton: report,
-        })
+        Ok(self.work.with_system(&input, f))
     }
 
     /// Commit the converged step: Gauss point states and node positions x = X̃ + Δu.
     fn commit(&mut self) {
-        for (p, state) in self.gauss.state.iter_mut().enumerate() {
-            *state = self.trials[p].as_ref().expect("converged trial").committed();
+        for (state, new) in self.gauss.state.iter_mut().zip(self.work.committed_states()) {
+            *state = new;
         }
-        for (x, du) in self.mesh.nodes.iter_mut().zip(&self.du_nodal) {
+        for (x, du) in self.mesh.nodes.iter_mut().zip(&self.work.du_nodal) {
             *x += du;
         }
-    }
-
-    /// Run all remaining load steps. On failure returns the reports of the converged steps
-    /// and the error.
-    pub fn run(&mut self) -> Result<Vec<StepReport>, (Vec<StepReport>, SolveError)> {
-        let mut reports = Vec::with_capacity(self.settings.load_steps);
-        while self.step < self.settings.load_steps {
-            match self.step() {
-                Ok(r) => reports.push(r),
-                Err(e) => return Err((reports, e)),
-            }
-        }
-        Ok(reports)
     }
 
     /// Current position x(ξ_q) and Jacobian dx/dξ of Gauss point `p` on the current mesh.
@@ -339,6 +285,39 @@ impl LineFem {
     /// Displacement of node `n` since the start of the analysis.
     pub fn displacement(&self, n: usize) -> f64 {
         self.mesh.nodes[n] - self.mesh0.nodes[n]
+    }
+}
+
+impl LoadStepping for LineFem {
+    fn step(&mut self) -> Result<StepReport, SolveError> {
+        let step = self.step + 1;
+        let fail = |failure, residuals| SolveError {
+            step,
+            failure,
+            residuals,
+        };
+        let load_factor = step as f64 / self.settings.load_steps as f64;
+        let newton_settings = self.settings.newton;
+        let report = self
+            .with_step_system(load_factor, |system| {
+                let mut u = vec![0.0; crate::newton::NonlinearSystem::num_unknowns(system)];
+                crate::newton::solve(system, &mut u, &newton_settings)
+            })
+            .map_err(|f| fail(f, vec![]))?
+            .map_err(|(f, r)| fail(f, r))?;
+        self.commit();
+        self.step = step;
+        Ok(StepReport {
+            step,
+            load_factor,
+            newton: report,
+        })
+    }
+    fn steps_done(&self) -> usize {
+        self.step
+    }
+    fn load_steps(&self) -> usize {
+        self.settings.load_steps
     }
 }
 
