@@ -421,6 +421,25 @@ pub struct PointRecord {
     pub plastic_multiplier: f64,
 }
 
+/// Yield height seen by a discretisation: the deviatoric measure ρ = |τ_xx − τ_zz| (eq 50,
+/// τ = σ F) of the two lowest unyielded points, extrapolated linearly to ρ = ρ_y. `None` if
+/// no point yielded or fewer than two stayed elastic.
+pub fn yield_height_estimate(points: &[PointRecord], yield_stress: f64) -> Option<f64> {
+    if !points.iter().any(|p| p.plastic_multiplier > 0.0) {
+        return None;
+    }
+    let mut elastic: Vec<&PointRecord> = points.iter().filter(|p| p.plastic_multiplier == 0.0).collect();
+    elastic.sort_by(|a, b| a.z0.total_cmp(&b.z0));
+    let rho = |p: &PointRecord| ((p.sigma_xx - p.sigma_zz) * p.f_zz).abs();
+    match elastic.as_slice() {
+        [a, b, ..] => {
+            let (ra, rb) = (rho(a), rho(b));
+            Some(a.z0 + (yield_stress - ra) * (b.z0 - a.z0) / (rb - ra))
+        }
+        _ => None,
+    }
+}
+
 /// Outcome of one column analysis.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ColumnOutcome {
