@@ -141,10 +141,17 @@ impl Basis {
                         t
                     }
                 };
-                let t_lo = snap((x - r - origin) / h);
-                let t_hi = snap((x + r - origin) / h);
-                if !(t_lo >= -1e-12 && t_hi <= cells as f64 + 1e-12) {
+                let t_c = (x - origin) / h;
+                if !(t_c >= -1e-12 && t_c <= cells as f64 + 1e-12) {
                     return Err(BasisError::OutsideGrid { axis });
+                }
+                // Eq (3) integrates over Ω_p ∩ Ω: the part of a domain beyond the grid (a
+                // rigid boundary or symmetry plane of the problem) is cut off, and the weights
+                // are normalised by the remaining length so that they still sum to one.
+                let t_lo = snap((x - r - origin) / h).max(0.0);
+                let t_hi = snap((x + r - origin) / h).min(cells as f64);
+                if t_hi <= t_lo {
+                    return Err(BasisError::DegenerateDomain { axis });
                 }
                 let e_lo = (t_lo.floor().max(0.0) as usize).min(cells - 1);
                 let e_hi = ((t_hi.ceil().max(1.0) as usize) - 1).min(cells - 1).max(e_lo);

@@ -32,11 +32,23 @@ pub struct MpmSettings {
     pub newton: NewtonSettings,
     /// Number of equal load increments.
     pub load_steps: usize,
+    /// Weak-node treatment: a grid node whose share of material volume Σ_p S_vp V_p is below
+    /// this fraction of an element's volume has its increment fixed at zero for the step.
+    /// Such nodes (a domain grazing an element) make the tangent nearly singular. 0 disables.
+    #[serde(default)]
+    pub weak_node_tolerance: f64,
 }
 
 impl MpmSettings {
     pub fn validate(&self) -> Result<(), InputError> {
         self.newton.validate()?;
+        if !(self.weak_node_tolerance >= 0.0 && self.weak_node_tolerance < 1.0) {
+            return Err(InputError::new(
+                "weak_node_tolerance",
+                self.weak_node_tolerance,
+                "must lie in [0, 1)",
+            ));
+        }
         require_count("load_steps", self.load_steps, 1)?;
         if self.load_steps > 1_000_000 {
             return Err(InputError::new(
@@ -166,6 +178,29 @@ impl<const D: usize> MpmSolver<D> {
         &self.work.table
     }
 
+    /// Nodes whose material volume share Σ_p S_vp V_p^n is positive but below
+    /// `weak_node_tolerance` × element volume, from the current supports.
+    pub fn weak_nodes(&self) -> Vec<usize> {
+        let tol = self.settings.weak_node_tolerance;
+        if tol <= 0.0 {
+            return vec![];
+        }
+        let cell: f64 = self.grid.spacing().iter().product();
+        let mut share = vec![0.0; self.grid.num_nodes()];
+        let mut touched = vec![false; self.grid.num_nodes()];
+        let table = &self.work.table;
+        for p in 0..table.num_points() {
+            let (nodes, s, _) = table.point(p);
+            for (&n, &w) in nodes.iter().zip(s) {
+                share[n] += w * self.points.state[p].volume;
+                touched[n] = true;
+            }
+        }
+        (0..share.len())
+            .filter(|&n| touched[n] && share[n] < tol * cell)
+            .collect()
+    }
+
     fn external_point_forces(&self, load_factor: f64) -> Vec<SVector<f64, D>> {
         let mut forces: Vec<SVector<f64, D>> = self
             .points
@@ -212,11 +247,14 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
         let load_factor = step as f64 / self.settings.load_steps as f64;
         self.build_supports().map_err(|f| fail(f, vec![]))?;
         let forces = self.external_point_forces(load_factor);
+        let weak = self.weak_nodes();
+        let mut fixed = self.fixed.clone();
+        fixed.extend(weak.iter().flat_map(|&n| (0..D).map(move |a| (n, a))));
         let input = StepInput {
             model: self.model.as_ref(),
             states: &self.points.state,
             num_nodes: self.grid.num_nodes(),
-            fixed: &self.fixed,
+            fixed: &fixed,
             point_forces: &forces,
             nodal_forces: &[],
         };
@@ -230,6 +268,7 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
             step,
             load_factor,
             newton: report,
+            weak_nodes: weak.len(),
         })
     }
     fn steps_done(&self) -> usize {

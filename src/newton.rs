@@ -199,6 +199,9 @@ pub struct StepReport {
     pub step: usize,
     pub load_factor: f64,
     pub newton: NewtonReport,
+    /// Grid nodes constrained by the weak-node treatment in this step (0 for FEM).
+    #[serde(default)]
+    pub weak_nodes: usize,
 }
 
 /// A solver that advances through a fixed number of proportional load steps.

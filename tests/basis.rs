@@ -200,99 +200,56 @@ fn gimp_continuous_across_element_edges_mpm_gradient_jumps() {
     }
 }
 
-/// A domain that leaves the grid, and a collapsed domain, are errors, not silent weights.
+const AXIS: GridAxis = GridAxis {
+    axis: 0,
+    origin: 0.0,
+    spacing: 1.0,
+    cells: 4,
+};
+
+/// A point outside the grid and a collapsed domain are errors, not silent weights.
 #[test]
 fn points_outside_grid_and_degenerate_domains_are_errors() {
     let mut ax = AxisWeights::default();
-    assert!(Basis::Gimp
-        .axis_weights(
-            GridAxis {
-                axis: 0,
-                origin: 0.0,
-                spacing: 1.0,
-                cells: 4
-            },
-            0.1,
-            0.2,
-            &mut ax
-        )
-        .is_err());
-    assert!(Basis::Gimp
-        .axis_weights(
-            GridAxis {
-                axis: 0,
-                origin: 0.0,
-                spacing: 1.0,
-                cells: 4
-            },
-            3.9,
-            0.2,
-            &mut ax
-        )
-        .is_err());
-    assert!(Basis::Gimp
-        .axis_weights(
-            GridAxis {
-                axis: 0,
-                origin: 0.0,
-                spacing: 1.0,
-                cells: 4
-            },
-            2.0,
-            0.0,
-            &mut ax
-        )
-        .is_err());
-    assert!(Basis::Gimp
-        .axis_weights(
-            GridAxis {
-                axis: 0,
-                origin: 0.0,
-                spacing: 1.0,
-                cells: 4
-            },
-            2.0,
-            f64::NAN,
-            &mut ax
-        )
-        .is_err());
-    assert!(Basis::Gimp
-        .axis_weights(
-            GridAxis {
-                axis: 0,
-                origin: 0.0,
-                spacing: 1.0,
-                cells: 4
-            },
-            2.0,
-            1.6,
-            &mut ax
-        )
-        .is_err());
-    assert!(Basis::Mpm
-        .axis_weights(
-            GridAxis {
-                axis: 0,
-                origin: 0.0,
-                spacing: 1.0,
-                cells: 4
-            },
-            -0.1,
-            0.2,
-            &mut ax
-        )
-        .is_err());
-    assert!(Basis::Mpm
-        .axis_weights(
-            GridAxis {
-                axis: 0,
-                origin: 0.0,
-                spacing: 1.0,
-                cells: 4
-            },
-            f64::NAN,
-            0.2,
-            &mut ax
-        )
-        .is_err());
+    for (x, r) in [
+        (-0.1, 0.2),
+        (4.1, 0.2),
+        (2.0, 0.0),
+        (2.0, -0.1),
+        (2.0, f64::NAN),
+        (2.0, 1.6),
+        (f64::NAN, 0.1),
+    ] {
+        assert!(
+            Basis::Gimp.axis_weights(AXIS, x, r, &mut ax).is_err(),
+            "GIMP ({x}, {r})"
+        );
+    }
+    for x in [-0.1, 4.1, f64::NAN] {
+        assert!(Basis::Mpm.axis_weights(AXIS, x, 0.2, &mut ax).is_err(), "MPM {x}");
+    }
+}
+
+/// A domain protruding past the grid boundary (a rigid wall or symmetry plane) is cut at it,
+/// eq (3)'s Ω_p ∩ Ω, and the weights of the remaining part still form a partition of unity
+/// with zero gradient sum.
+#[test]
+fn gimp_domain_is_clipped_at_the_grid_boundary() {
+    let mut ax = AxisWeights::default();
+    for (x, r) in [(0.1, 0.2), (3.95, 0.2), (0.05, 0.3)] {
+        Basis::Gimp.axis_weights(AXIS, x, r, &mut ax).unwrap();
+        let s: f64 = ax.w[..ax.len].iter().sum();
+        let g: f64 = ax.dw[..ax.len].iter().sum();
+        assert!((s - 1.0).abs() < 1e-14 && g.abs() < 1e-13, "({x}, {r}): {s} {g}");
+        // Equal to the weights of the clipped domain itself.
+        let (lo, hi) = ((x - r).max(0.0), (x + r).min(4.0));
+        let mut clipped = AxisWeights::default();
+        Basis::Gimp
+            .axis_weights(AXIS, 0.5 * (lo + hi), 0.5 * (hi - lo), &mut clipped)
+            .unwrap();
+        assert_eq!(ax.len, clipped.len);
+        for k in 0..ax.len {
+            assert!((ax.w[k] - clipped.w[k]).abs() < 1e-14);
+        }
+    }
 }

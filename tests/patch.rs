@@ -26,6 +26,7 @@ fn patch<const D: usize>(
         domain_update: DomainUpdate::Stretch,
         newton: NewtonSettings::default(),
         load_steps: 1,
+        weak_node_tolerance: 0.0,
     };
     let loads = Loads {
         gravity: SVector::<f64, D>::zeros(),

@@ -188,6 +188,7 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
             domain_update: DomainUpdate::Stretch,
             newton: NewtonSettings::default(),
             load_steps: 1,
+            weak_node_tolerance: 0.0,
         };
         let loads = Loads {
             gravity: SVector::<f64, 2>::zeros(),

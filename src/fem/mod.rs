@@ -311,6 +311,7 @@ impl LoadStepping for LineFem {
             step,
             load_factor,
             newton: report,
+            weak_nodes: 0,
         })
     }
     fn steps_done(&self) -> usize {

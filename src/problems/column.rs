@@ -397,6 +397,7 @@ impl ColumnSpec {
             domain_update: DomainUpdate::Stretch,
             newton: self.newton,
             load_steps: self.load_steps,
+            weak_node_tolerance: 0.0,
         };
         MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, settings)
     }

@@ -1,0 +1,219 @@
+//! Plane-strain compaction of a block under its own weight (§5.2, Figures 15–18, Tables 2–3).
+//!
+//! Geometry as we read the paper: the full block is `2 × half_width` wide and `height` high; by
+//! symmetry the half `0 ≤ x ≤ half_width` is modelled, with a roller (u_x = 0) on the symmetry
+//! line x = 0 and u_y = 0 on the bottom edge y = 0. It sits in a background grid covering
+//! `[0, grid_extent[0]] × [0, grid_extent[1]]`, which leaves room for the material to spread.
+//! `weight` is the weight of the full block; the modelled half carries half of it, applied by
+//! gravity ramped over the load steps (ρ0 g = weight / (2 half_width · height), density 1).
+
+use crate::basis::Basis;
+use crate::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
+use crate::error::{require_count, require_positive, InputError, SolveError};
+use crate::grid::Grid;
+use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
+use crate::newton::{LoadStepping, NewtonSettings, StepReport};
+use crate::particles::MaterialPoints;
+use nalgebra::SVector;
+use serde::{Deserialize, Serialize};
+
+/// Parameters of the compaction problem (defaults: the paper's elastic case, h = 1, 2×2 points).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompactionSpec {
+    /// Half width of the block (the modelled part).
+    pub half_width: f64,
+    pub height: f64,
+    /// Background grid extent along x and y (origin at the symmetry line / bottom).
+    pub grid_extent: [f64; 2],
+    /// Element size h (the same along both axes).
+    pub element_size: f64,
+    /// Material points per element along each axis.
+    pub points_per_cell: usize,
+    pub young_modulus: f64,
+    pub poisson_ratio: f64,
+    /// Weight of the full block, W.
+    pub weight: f64,
+    /// Von Mises yield stress ρ_y; absent for the elastic case.
+    #[serde(default)]
+    pub yield_stress: Option<f64>,
+    pub load_steps: usize,
+    pub newton: NewtonSettings,
+    /// See [`MpmSettings::weak_node_tolerance`].
+    pub weak_node_tolerance: f64,
+    pub basis: Basis,
+    pub domain_update: DomainUpdate,
+}
+
+impl Default for CompactionSpec {
+    fn default() -> Self {
+        Self {
+            half_width: 4.0,
+            height: 8.0,
+            grid_extent: [10.0, 10.0],
+            element_size: 1.0,
+            points_per_cell: 2,
+            young_modulus: 1e5,
+            poisson_ratio: 0.3,
+            weight: 4e5,
+            yield_stress: None,
+            load_steps: 20,
+            newton: NewtonSettings::default(),
+            weak_node_tolerance: 1e-3,
+            basis: Basis::Gimp,
+            domain_update: DomainUpdate::Stretch,
+        }
+    }
+}
+
+impl CompactionSpec {
+    pub fn validate(&self) -> Result<(), InputError> {
+        require_positive("half_width", self.half_width)?;
+        require_positive("height", self.height)?;
+        require_positive("element_size", self.element_size)?;
+        require_positive("weight", self.weight)?;
+        require_count("points_per_cell", self.points_per_cell, 1)?;
+        if self.points_per_cell > 16 {
+            return Err(InputError::new(
+                "points_per_cell",
+                self.points_per_cell,
+                "must be <= 16",
+            ));
+        }
+        require_count("load_steps", self.load_steps, 1)?;
+        self.newton.validate()?;
+        for a in 0..2 {
+            require_positive(&format!("grid_extent[{a}]"), self.grid_extent[a])?;
+            let n = self.grid_extent[a] / self.element_size;
+            if (n - n.round()).abs() > 1e-9 * n || n.round() > 100_000.0 {
+                return Err(InputError::new(
+                    format!("grid_extent[{a}]"),
+                    self.grid_extent[a],
+                    format!(
+                        "must be a whole multiple (<= 100000) of element_size = {}",
+                        self.element_size
+                    ),
+                ));
+            }
+        }
+        if self.half_width > self.grid_extent[0] || self.height > self.grid_extent[1] {
+            return Err(InputError::new(
+                "grid_extent",
+                format!("{:?}", self.grid_extent),
+                format!("must contain the block {} x {}", self.half_width, self.height),
+            ));
+        }
+        self.model()?;
+        Ok(())
+    }
+
+    /// Linear elastic, or von Mises when `yield_stress` is set.
+    pub fn model(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
+        match self.yield_stress {
+            None => Ok(Box::new(LinearElastic::try_new(
+                self.young_modulus,
+                self.poisson_ratio,
+            )?)),
+            Some(ry) => Ok(Box::new(VonMises::try_new(
+                self.young_modulus,
+                self.poisson_ratio,
+                ry,
+            )?)),
+        }
+    }
+
+    /// ρ0 g of the block (density 1).
+    pub fn unit_weight(&self) -> f64 {
+        self.weight / (2.0 * self.half_width * self.height)
+    }
+
+    /// The iGIMP/MPM solver of this problem.
+    pub fn mpm_solver(&self) -> Result<MpmSolver<2>, InputError> {
+        self.validate()?;
+        let h = self.element_size;
+        let cells = [
+            (self.grid_extent[0] / h).round() as usize,
+            (self.grid_extent[1] / h).round() as usize,
+        ];
+        let grid = Grid::try_new([0.0, 0.0], [h, h], cells)?;
+        let ppc = self.points_per_cell;
+        let points =
+            MaterialPoints::fill_box(&grid, [0.0, 0.0], [self.half_width, self.height], [ppc, ppc], 1.0)?;
+        let mut fixed: Vec<(usize, usize)> =
+            grid.nodes_on_plane(0, 0.0).into_iter().map(|n| (n, 0)).collect();
+        fixed.extend(grid.nodes_on_plane(1, 0.0).into_iter().map(|n| (n, 1)));
+        let loads = Loads {
+            gravity: SVector::<f64, 2>::new(0.0, -self.unit_weight()),
+            point_loads: vec![],
+        };
+        let settings = MpmSettings {
+            basis: self.basis,
+            domain_update: self.domain_update,
+            newton: self.newton,
+            load_steps: self.load_steps,
+            weak_node_tolerance: self.weak_node_tolerance,
+        };
+        MpmSolver::try_new(grid, points, self.model()?, fixed, loads, settings)
+    }
+}
+
+/// Final state of one material point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DomainRecord {
+    pub x0: [f64; 2],
+    pub x: [f64; 2],
+    /// Initial and current domain half-lengths.
+    pub half0: [f64; 2],
+    pub half: [f64; 2],
+    /// Cauchy stress σ_yy.
+    pub sigma_yy: f64,
+    pub plastic_multiplier: f64,
+}
+
+/// Outcome of one compaction analysis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompactionOutcome {
+    pub steps: Vec<StepReport>,
+    pub failure: Option<SolveError>,
+    /// Horizontal displacement of the bottom-right point plus half the growth of its domain
+    /// (the measure of Figure 17).
+    pub max_horizontal_displacement: f64,
+    /// Total number of weak-node constraints applied over all steps.
+    pub weak_nodes_treated: usize,
+    pub points: Vec<DomainRecord>,
+}
+
+/// Run the compaction problem with material points.
+pub fn solve_mpm(spec: &CompactionSpec) -> Result<CompactionOutcome, InputError> {
+    let mut solver = spec.mpm_solver()?;
+    let (steps, failure) = match solver.run() {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    let pts = &solver.points;
+    // Bottom-right point: lowest row, largest x.
+    let min_y = pts.position0.iter().map(|x| x[1]).fold(f64::INFINITY, f64::min);
+    let corner = (0..pts.len())
+        .filter(|&p| (pts.position0[p][1] - min_y).abs() < 1e-12)
+        .max_by(|&a, &b| pts.position0[a][0].total_cmp(&pts.position0[b][0]))
+        .expect("at least one point");
+    let max_horizontal_displacement =
+        pts.displacement(corner)[0] + (pts.half_length[corner][0] - pts.half_length0[corner][0]);
+    let points = (0..pts.len())
+        .map(|p| DomainRecord {
+            x0: [pts.position0[p][0], pts.position0[p][1]],
+            x: [pts.position[p][0], pts.position[p][1]],
+            half0: [pts.half_length0[p][0], pts.half_length0[p][1]],
+            half: [pts.half_length[p][0], pts.half_length[p][1]],
+            sigma_yy: pts.state[p].cauchy()[(1, 1)],
+            plastic_multiplier: pts.state[p].material.plastic_multiplier,
+        })
+        .collect();
+    Ok(CompactionOutcome {
+        weak_nodes_treated: steps.iter().map(|s| s.weak_nodes).sum(),
+        steps,
+        failure,
+        max_horizontal_displacement,
+        points,
+    })
+}
