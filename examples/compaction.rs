@@ -6,12 +6,14 @@ fn main() {
     let h = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1.0);
     let ppc = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(2);
     let yield_stress = args.get(3).and_then(|s| s.parse().ok());
-    let spec = CompactionSpec {
+    let line_search = args.get(4).is_some_and(|s| s == "ls");
+    let mut spec = CompactionSpec {
         element_size: h,
         points_per_cell: ppc,
         yield_stress,
         ..CompactionSpec::default()
     };
+    spec.newton.line_search = line_search;
     let t = std::time::Instant::now();
     let o = solve_mpm(&spec).expect("valid input");
     println!(

@@ -101,11 +101,14 @@ pub struct DofMap {
 
 impl DofMap {
     /// Active nodes are those touched by a point with a non-zero weight or gradient; a dof is
-    /// free if its node is active and `(node, axis)` is not in `fixed`.
+    /// free if its node is active and `(node, axis)` is not in `fixed`. `ties` lists
+    /// `(slave, master)` node pairs whose dofs share the master's equations (u_slave = u_master),
+    /// so forces and stiffness at the slave are summed into the master's rows and columns.
     pub fn build<const D: usize>(
         num_nodes: usize,
         table: &SupportTable<D>,
         fixed: &[(usize, usize)],
+        ties: &[(usize, usize)],
     ) -> Self {
         let mut active = vec![false; num_nodes];
         for p in 0..table.num_points() {
@@ -123,9 +126,13 @@ impl DofMap {
                 is_fixed[n * D + a] = true;
             }
         }
+        let mut slave = vec![false; num_nodes];
+        for &(s, _) in ties {
+            slave[s] = true;
+        }
         let mut count = 0;
         for n in 0..num_nodes {
-            if !active[n] {
+            if !active[n] || slave[n] {
                 continue;
             }
             for a in 0..D {
@@ -133,6 +140,12 @@ impl DofMap {
                     eq[n * D + a] = Some(count);
                     count += 1;
                 }
+            }
+        }
+        for &(s, m) in ties {
+            assert!(!slave[m], "tie master {m} is itself a slave");
+            for a in 0..D {
+                eq[s * D + a] = if is_fixed[s * D + a] { None } else { eq[m * D + a] };
             }
         }
         Self { eq, count }
@@ -157,6 +170,15 @@ impl DofMap {
     pub fn expand(&self, u: &[f64], nodal: &mut [f64]) {
         for (dof, e) in self.eq.iter().enumerate() {
             nodal[dof] = e.map_or(0.0, |e| u[e]);
+        }
+    }
+    /// Sum a nodal force vector into equation order (tied dofs add into their master).
+    pub fn gather_forces(&self, nodal: &[f64], f: &mut [f64]) {
+        f.iter_mut().for_each(|v| *v = 0.0);
+        for (dof, e) in self.eq.iter().enumerate() {
+            if let Some(e) = *e {
+                f[e] += nodal[dof];
+            }
         }
     }
     /// Gather a nodal vector into equation order.
@@ -379,6 +401,8 @@ pub struct StepInput<'a, const D: usize> {
     pub num_nodes: usize,
     /// Homogeneous Dirichlet conditions (node, axis).
     pub fixed: &'a [(usize, usize)],
+    /// Nodes tied to a master node (slave, master): u_slave = u_master.
+    pub ties: &'a [(usize, usize)],
     /// Force carried by each point (body force × mass, point loads), mapped with the weights (eq 40).
     pub point_forces: &'a [SVector<f64, D>],
     /// Forces applied directly to nodal dofs (dof = node·D + axis).
@@ -393,7 +417,7 @@ impl<const D: usize> StepWorkspace<D> {
         input: &StepInput<'_, D>,
         f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
     ) -> R {
-        let dofs = DofMap::build(input.num_nodes, &self.table, input.fixed);
+        let dofs = DofMap::build(input.num_nodes, &self.table, input.fixed, input.ties);
         self.matrix.set_pattern(dofs.pattern(&self.table));
         let mut nodal = vec![0.0; dofs.num_dofs()];
         map_point_forces(&self.table, input.point_forces, &mut nodal);
@@ -401,7 +425,7 @@ impl<const D: usize> StepWorkspace<D> {
             nodal[dof] += force;
         }
         let mut f_ext = vec![0.0; dofs.len()];
-        dofs.gather(&nodal, &mut f_ext);
+        dofs.gather_forces(&nodal, &mut f_ext);
         let mut system = LoadStepSystem {
             model: input.model,
             states: input.states,

@@ -32,11 +32,26 @@ pub struct MpmSettings {
     pub newton: NewtonSettings,
     /// Number of equal load increments.
     pub load_steps: usize,
-    /// Weak-node treatment: a grid node whose share of material volume Σ_p S_vp V_p is below
-    /// this fraction of an element's volume has its increment fixed at zero for the step.
-    /// Such nodes (a domain grazing an element) make the tangent nearly singular. 0 disables.
+    /// Weak nodes: a grid node whose share of material volume Σ_p S_vp V_p is below this
+    /// fraction of an element's volume (a domain grazing an element) makes the tangent nearly
+    /// singular and is treated by `weak_node_treatment` for the step. 0 disables.
     #[serde(default)]
     pub weak_node_tolerance: f64,
+    #[serde(default)]
+    pub weak_node_treatment: WeakNodeTreatment,
+}
+
+/// How weak nodes are treated in a load step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum WeakNodeTreatment {
+    /// Tie the node to its strongest grid neighbour (same increment): moves the sliver of
+    /// material with its neighbour instead of pinning it. Falls back to `Fix` when no
+    /// neighbour has enough material.
+    #[default]
+    Tie,
+    /// Fix the node's increment at zero.
+    Fix,
 }
 
 impl MpmSettings {
@@ -179,11 +194,12 @@ impl<const D: usize> MpmSolver<D> {
     }
 
     /// Nodes whose material volume share Σ_p S_vp V_p^n is positive but below
-    /// `weak_node_tolerance` × element volume, from the current supports.
-    pub fn weak_nodes(&self) -> Vec<usize> {
+    /// `weak_node_tolerance` × element volume, from the current supports, and the
+    /// (slave, master) ties chosen for them under [`WeakNodeTreatment::Tie`].
+    pub fn weak_nodes(&self) -> (Vec<usize>, Vec<(usize, usize)>) {
         let tol = self.settings.weak_node_tolerance;
         if tol <= 0.0 {
-            return vec![];
+            return (vec![], vec![]);
         }
         let cell: f64 = self.grid.spacing().iter().product();
         let mut share = vec![0.0; self.grid.num_nodes()];
@@ -196,9 +212,41 @@ impl<const D: usize> MpmSolver<D> {
                 touched[n] = true;
             }
         }
-        (0..share.len())
-            .filter(|&n| touched[n] && share[n] < tol * cell)
-            .collect()
+        let threshold = tol * cell;
+        let weak: Vec<usize> = (0..share.len())
+            .filter(|&n| touched[n] && share[n] < threshold)
+            .collect();
+        let mut ties = Vec::new();
+        if self.settings.weak_node_treatment == WeakNodeTreatment::Tie {
+            for &n in &weak {
+                let idx = self.grid.node_coords(n);
+                let mut best: Option<(usize, f64)> = None;
+                for a in 0..D {
+                    for up in [false, true] {
+                        let mut j = idx;
+                        if up {
+                            if j[a] + 1 >= self.grid.nodes_along(a) {
+                                continue;
+                            }
+                            j[a] += 1;
+                        } else {
+                            if j[a] == 0 {
+                                continue;
+                            }
+                            j[a] -= 1;
+                        }
+                        let m = self.grid.node_index(j);
+                        if share[m] >= threshold && best.is_none_or(|(_, s)| share[m] > s) {
+                            best = Some((m, share[m]));
+                        }
+                    }
+                }
+                if let Some((m, _)) = best {
+                    ties.push((n, m));
+                }
+            }
+        }
+        (weak, ties)
     }
 
     fn external_point_forces(&self, load_factor: f64) -> Vec<SVector<f64, D>> {
@@ -247,14 +295,20 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
         let load_factor = step as f64 / self.settings.load_steps as f64;
         self.build_supports().map_err(|f| fail(f, vec![]))?;
         let forces = self.external_point_forces(load_factor);
-        let weak = self.weak_nodes();
+        let (weak, ties) = self.weak_nodes();
         let mut fixed = self.fixed.clone();
-        fixed.extend(weak.iter().flat_map(|&n| (0..D).map(move |a| (n, a))));
+        let tied: Vec<usize> = ties.iter().map(|t| t.0).collect();
+        fixed.extend(
+            weak.iter()
+                .filter(|n| !tied.contains(n))
+                .flat_map(|&n| (0..D).map(move |a| (n, a))),
+        );
         let input = StepInput {
             model: self.model.as_ref(),
             states: &self.points.state,
             num_nodes: self.grid.num_nodes(),
             fixed: &fixed,
+            ties: &ties,
             point_forces: &forces,
             nodal_forces: &[],
         };

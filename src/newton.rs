@@ -11,6 +11,12 @@ pub struct NewtonSettings {
     pub tolerance: f64,
     /// Most Newton iterations (linear solves) per load step.
     pub max_iterations: usize,
+    /// Backtrack (halve the update, up to 10 times) while the normalised residual does not
+    /// decrease or the trial state is inadmissible (e.g. det ΔF ≤ 0). Off by default: plain
+    /// Newton as in the paper. Full steps are taken near the solution either way, so the
+    /// asymptotic quadratic rate is unaffected.
+    #[serde(default)]
+    pub line_search: bool,
 }
 
 impl Default for NewtonSettings {
@@ -18,6 +24,7 @@ impl Default for NewtonSettings {
         Self {
             tolerance: 1e-9,
             max_iterations: 30,
+            line_search: false,
         }
     }
 }
@@ -85,39 +92,72 @@ pub fn solve(
     } else {
         1.0
     };
-    for it in 0..=settings.max_iterations {
-        if let Err(f) = system.evaluate(u, &mut r) {
-            return Err((f, history));
-        }
-        let res = norm(&r) / scale;
-        if !res.is_finite() {
-            return Err((StepFailure::NonFinite { iteration: it }, history));
-        }
-        history.push(res);
+    if let Err(f) = system.evaluate(u, &mut r) {
+        return Err((f, history));
+    }
+    let mut res = norm(&r) / scale;
+    if !res.is_finite() {
+        return Err((StepFailure::NonFinite { iteration: 0 }, history));
+    }
+    history.push(res);
+    let mut delta = vec![0.0; n];
+    let mut trial = vec![0.0; n];
+    for it in 1..=settings.max_iterations {
         if res <= settings.tolerance {
             return Ok(NewtonReport { residuals: history });
         }
-        if it == settings.max_iterations {
-            break;
+        // K δ = −r, eq (22), with the tangent of the last evaluated (accepted) state.
+        for (d, ri) in delta.iter_mut().zip(&r) {
+            *d = -ri;
         }
-        // K δ = −r, eq (22); Δd += δ, eq (23).
-        r.iter_mut().for_each(|x| *x = -*x);
-        if let Err(f) = system.solve_tangent(&mut r) {
+        if let Err(f) = system.solve_tangent(&mut delta) {
             return Err((f, history));
         }
-        for (ui, di) in u.iter_mut().zip(&r) {
-            *ui += di;
+        // Δd += α δ, eq (23); α = 1 unless the line search backtracks.
+        let mut alpha = 1.0;
+        let mut halvings = 0;
+        loop {
+            for ((t, ui), di) in trial.iter_mut().zip(u.iter()).zip(&delta) {
+                *t = ui + alpha * di;
+            }
+            let last_try = !settings.line_search || halvings == MAX_HALVINGS;
+            match system.evaluate(&trial, &mut r) {
+                Ok(()) => {
+                    let res_t = norm(&r) / scale;
+                    if res_t.is_finite() && (last_try || res_t < (1.0 - 1e-4 * alpha) * res) {
+                        u.copy_from_slice(&trial);
+                        res = res_t;
+                        break;
+                    }
+                    if last_try {
+                        return Err((StepFailure::NonFinite { iteration: it }, history));
+                    }
+                }
+                Err(f) => {
+                    if last_try {
+                        return Err((f, history));
+                    }
+                }
+            }
+            alpha *= 0.5;
+            halvings += 1;
         }
+        history.push(res);
     }
-    let last = *history.last().unwrap_or(&f64::NAN);
+    if res <= settings.tolerance {
+        return Ok(NewtonReport { residuals: history });
+    }
     Err((
         StepFailure::NotConverged {
             iterations: settings.max_iterations,
-            last,
+            last: res,
         },
         history,
     ))
 }
+
+/// Most step halvings of the backtracking line search.
+const MAX_HALVINGS: usize = 10;
 
 /// Observed convergence order from three successive residuals, ln(r3/r2)/ln(r2/r1).
 pub fn observed_order(r1: f64, r2: f64, r3: f64) -> f64 {

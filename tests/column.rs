@@ -44,6 +44,7 @@ fn newton_converges_quadratically_on_the_column() {
                 newton: NewtonSettings {
                     tolerance: 1e-11,
                     max_iterations: 30,
+                    line_search: false,
                 },
                 ..table1_spec(256)
             };
@@ -231,6 +232,7 @@ fn bad_column_input_names_the_field() {
                 newton: NewtonSettings {
                     tolerance: f64::NAN,
                     max_iterations: 5,
+                    line_search: false,
                 },
                 ..Default::default()
             },
@@ -241,6 +243,7 @@ fn bad_column_input_names_the_field() {
                 newton: NewtonSettings {
                     tolerance: 1e-9,
                     max_iterations: 0,
+                    line_search: false,
                 },
                 ..Default::default()
             },
@@ -271,6 +274,7 @@ fn points_outside_grid_rejected_and_divergence_recorded() {
         newton: NewtonSettings {
             tolerance: 1e-12,
             max_iterations: 1,
+            line_search: false,
         },
         ..table1_spec(16)
     };

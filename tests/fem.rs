@@ -187,6 +187,7 @@ fn fem_quadratic_reproduces_linear_strain_small_strain() {
             newton: NewtonSettings {
                 tolerance: 1e-10,
                 max_iterations: 10,
+                line_search: false,
             },
             load_steps: 2,
         };

@@ -27,6 +27,7 @@ fn patch<const D: usize>(
         newton: NewtonSettings::default(),
         load_steps: 1,
         weak_node_tolerance: 0.0,
+        weak_node_treatment: Default::default(),
     };
     let loads = Loads {
         gravity: SVector::<f64, D>::zeros(),
@@ -36,7 +37,7 @@ fn patch<const D: usize>(
         MpmSolver::try_new(grid.clone(), points, Box::new(model), vec![], loads, settings).unwrap();
     solver.build_supports().unwrap();
     let table = solver.supports().clone();
-    let dofs = DofMap::build(grid.num_nodes(), &table, &[]);
+    let dofs = DofMap::build(grid.num_nodes(), &table, &[], &[]);
     let mut nodal = vec![0.0; dofs.num_dofs()];
     for n in 0..grid.num_nodes() {
         let u = (fbar - SMatrix::<f64, D, D>::identity()) * grid.node_position(n);

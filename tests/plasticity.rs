@@ -188,6 +188,7 @@ fn newton_converges_quadratically_on_the_plastic_column() {
             newton: NewtonSettings {
                 tolerance: 1e-10,
                 max_iterations: 30,
+                line_search: false,
             },
             ..plastic_spec(w, 256)
         };

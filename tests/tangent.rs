@@ -90,7 +90,7 @@ fn constitutive_tangent_matches_central_differences() {
 fn global_tangent_error<const D: usize>(solver: &mut MpmSolver<D>, u0_scale: f64, seed: u64) -> f64 {
     solver.build_supports().unwrap();
     let table = solver.supports().clone();
-    let dofs = DofMap::build(solver.grid.num_nodes(), &table, &solver.fixed);
+    let dofs = DofMap::build(solver.grid.num_nodes(), &table, &solver.fixed, &[]);
     let n = dofs.len();
     let mut matrix = SparseSystem::default();
     matrix.set_pattern(dofs.pattern(&table));
@@ -189,6 +189,7 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
             newton: NewtonSettings::default(),
             load_steps: 1,
             weak_node_tolerance: 0.0,
+            weak_node_treatment: Default::default(),
         };
         let loads = Loads {
             gravity: SVector::<f64, 2>::zeros(),

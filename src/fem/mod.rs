@@ -259,6 +259,7 @@ impl LineFem {
             states: &self.gauss.state,
             num_nodes: self.mesh.num_nodes(),
             fixed: &self.fixed_dofs,
+            ties: &[],
             point_forces: &forces,
             nodal_forces: &nodal,
         };

@@ -398,6 +398,7 @@ impl ColumnSpec {
             newton: self.newton,
             load_steps: self.load_steps,
             weak_node_tolerance: 0.0,
+            weak_node_treatment: Default::default(),
         };
         MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, settings)
     }

@@ -11,7 +11,7 @@ use crate::basis::Basis;
 use crate::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::grid::Grid;
-use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
+use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, WeakNodeTreatment};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::particles::MaterialPoints;
 use nalgebra::SVector;
@@ -41,6 +41,8 @@ pub struct CompactionSpec {
     pub newton: NewtonSettings,
     /// See [`MpmSettings::weak_node_tolerance`].
     pub weak_node_tolerance: f64,
+    #[serde(default)]
+    pub weak_node_treatment: WeakNodeTreatment,
     pub basis: Basis,
     pub domain_update: DomainUpdate,
 }
@@ -59,7 +61,8 @@ impl Default for CompactionSpec {
             yield_stress: None,
             load_steps: 20,
             newton: NewtonSettings::default(),
-            weak_node_tolerance: 1e-3,
+            weak_node_tolerance: 2e-2,
+            weak_node_treatment: WeakNodeTreatment::Tie,
             basis: Basis::Gimp,
             domain_update: DomainUpdate::Stretch,
         }
@@ -152,6 +155,7 @@ impl CompactionSpec {
             newton: self.newton,
             load_steps: self.load_steps,
             weak_node_tolerance: self.weak_node_tolerance,
+            weak_node_treatment: self.weak_node_treatment,
         };
         MpmSolver::try_new(grid, points, self.model()?, fixed, loads, settings)
     }
