@@ -1,4 +1,5 @@
 //! The paper's examples as problem definitions with their analytical references.
 
+pub mod cantilever;
 pub mod column;
 pub mod compaction;
