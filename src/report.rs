@@ -183,7 +183,7 @@ pub fn report_markdown(results: &StudyResults) -> String {
             opt(c.and_then(|c| c.top_displacement), &|v| format!("{v:.6}"))
         });
         row("top displacement (m), paper", &|i, _| {
-            format!("{}", p.top_displacement[i])
+            format!("{:.4}", p.top_displacement[i])
         });
         row("difference", &|i, c| {
             opt(c.and_then(|c| c.top_displacement), &|v| {
@@ -193,7 +193,7 @@ pub fn report_markdown(results: &StudyResults) -> String {
         row("base F, this code", &|_, c| {
             opt(c.and_then(|c| c.base_f), &|v| format!("{v:.6}"))
         });
-        row("base F, paper", &|i, _| format!("{}", p.base_f[i]));
+        row("base F, paper", &|i, _| format!("{:.5}", p.base_f[i]));
         row("difference", &|i, c| {
             opt(c.and_then(|c| c.base_f), &|v| format!("{:+.1e}", v - p.base_f[i]))
         });
