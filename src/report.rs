@@ -3,7 +3,7 @@
 //! `study --render-only` reproduces them byte for byte.
 
 use crate::plot::{self, ConvergenceSeries, ProfileSeries};
-use crate::problems::column::{ColumnSpec, ElasticColumn, Method};
+use crate::problems::column::{ColumnSpec, Method};
 use crate::study::rates::{case_error, pairwise_rates, series};
 use crate::study::runner::{
     points_file, read_points_csv, read_results, CaseRecord, CaseStatus, StudyResults,
@@ -49,8 +49,8 @@ fn status_word(c: &CaseRecord) -> &'static str {
     }
 }
 
-/// The analytical column of a load.
-pub fn analytical(results: &StudyResults, load: f64) -> ElasticColumn {
+/// The column of a load (for its analytical solution, `ColumnSpec::analytical`).
+pub fn column_at(results: &StudyResults, load: f64) -> ColumnSpec {
     let c = &results.study.column;
     ColumnSpec {
         length: c.length,
@@ -60,7 +60,6 @@ pub fn analytical(results: &StudyResults, load: f64) -> ElasticColumn {
         weight: load,
         ..ColumnSpec::default()
     }
-    .analytical()
 }
 
 /// The (method, points per cell) series of a sweep at one load, in plan order.
@@ -131,7 +130,7 @@ pub fn report_markdown(results: &StudyResults) -> String {
 
     for p in &spec.paper {
         let ppc = p.points_per_cell.map(|n| n as usize);
-        let exact = analytical(results, p.weight);
+        let exact = column_at(results, p.weight).analytical();
         let f0 = exact.deformation_gradient(0.0);
         let _ = writeln!(
             s,
@@ -412,7 +411,7 @@ pub fn render_figure(
                     });
                 }
             }
-            let exact = analytical(results, fig.weight);
+            let exact = column_at(results, fig.weight).analytical();
             let l0 = results.study.column.length;
             let curve: Vec<(f64, f64)> = (0..=200)
                 .map(|i| {
