@@ -14,6 +14,11 @@
 //! ([`quadrature`]), the paper's comparators. [`problems`] holds the paper's
 //! examples with their analytical solutions; [`norms`] the error measures (eqs 46–47).
 //!
+//! Verification studies are data (`studies/*.toml`): [`study`] parses them and runs the
+//! cases (compute → `results.json`), [`report`] and [`plot`] render tables and SVG figures
+//! from that file alone. The `study` binary is the front door:
+//! `cargo run --release --bin study -- column`.
+//!
 //! ## Notation
 //! | paper | Rust |
 //! |---|---|
@@ -41,6 +46,9 @@ pub mod mpm;
 pub mod newton;
 pub mod norms;
 pub mod particles;
+pub mod plot;
 pub mod problems;
 pub mod quadrature;
+pub mod report;
+pub mod study;
 pub mod tensor;

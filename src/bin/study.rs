@@ -1,1 +1,239 @@
-fn main() {}
+//! `study`: run the paper's verification studies and render their tables and figures.
+//!
+//! `cargo run --release --bin study -- column` solves every case of `studies/column.toml`,
+//! writes `reports/column/results.json` and the point files, then renders the tables, the
+//! SVG figures and `reports/index.md` from those files.
+
+use clap::{CommandFactory, FromArgMatches, Parser};
+use igimp::report;
+use igimp::study::runner::{read_results, run_study, study_dir, write_outputs, CaseRecord, CaseStatus};
+use igimp::study::{study_files, StudyError, StudySpec, Tier};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "study",
+    version,
+    about = "Run the iGIMP paper's verification studies: solve every case, write results.json, \
+             render tables and SVG figures",
+    long_about = None
+)]
+struct Cli {
+    /// Study names (files `<studies>/<name>.toml`), paths to study files, `all`, or `list`.
+    #[arg(required = true, value_name = "STUDY")]
+    studies: Vec<String>,
+    /// Run the quick tier (each sweep's `quick` overrides; what the tests and CI run).
+    #[arg(long)]
+    quick: bool,
+    /// Output folder; each study writes `<out>/<name>/`, and `<out>/index.md` links them.
+    #[arg(long, value_name = "DIR", default_value = "reports")]
+    out: PathBuf,
+    /// Redraw tables and figures from an existing `<out>/<name>/results.json` without solving.
+    #[arg(long)]
+    render_only: bool,
+    /// Folder of the study files.
+    #[arg(long, value_name = "DIR")]
+    studies_dir: Option<PathBuf>,
+    /// Exit with status 2 if an expected rate or comparison fails or could not be evaluated.
+    #[arg(long)]
+    check: bool,
+}
+
+/// `studies/` in the working directory, else the one in the source tree.
+fn default_studies_dir() -> PathBuf {
+    let local = PathBuf::from("studies");
+    if local.is_dir() {
+        local
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("studies")
+    }
+}
+
+/// (name, summary) of every valid study file in `dir`, and the errors of invalid ones.
+fn catalogue(dir: &Path) -> Vec<Result<(String, String), StudyError>> {
+    match study_files(dir) {
+        Ok(files) => files
+            .iter()
+            .map(|f| StudySpec::load(f).map(|s| (s.name, s.summary)))
+            .collect(),
+        Err(e) => vec![Err(e)],
+    }
+}
+
+fn studies_help(dir: &Path) -> String {
+    let mut s = format!("Studies (from {}):\n", dir.display());
+    for entry in catalogue(dir) {
+        match entry {
+            Ok((name, summary)) => s.push_str(&format!("  {name:<12} {summary}\n")),
+            Err(e) => s.push_str(&format!("  (invalid) {e}\n")),
+        }
+    }
+    s.push_str(
+        "\nExamples:\n  study column            full column study into reports/column/\n  \
+         study column --quick    the CI tier\n  study all --render-only redraw every report from results.json\n  \
+         study list              list the studies",
+    );
+    s
+}
+
+fn resolve(dir: &Path, name: &str) -> PathBuf {
+    let p = Path::new(name);
+    if name.ends_with(".toml") || p.components().count() > 1 {
+        p.to_path_buf()
+    } else {
+        dir.join(format!("{name}.toml"))
+    }
+}
+
+fn progress(n: u64) -> ProgressBar {
+    let bar = if std::io::stderr().is_terminal() {
+        ProgressBar::with_draw_target(Some(n), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    if let Ok(style) =
+        ProgressStyle::with_template("{prefix:>8} [{bar:40}] {pos}/{len} cases {elapsed} {msg}")
+    {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
+fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
+    let spec = StudySpec::load(file)?;
+    let dir = study_dir(&cli.out, &spec.name);
+    if !cli.render_only {
+        let tier = if cli.quick { Tier::Quick } else { Tier::Full };
+        let n = spec.cases(tier).len() as u64;
+        let bar = progress(n);
+        bar.set_prefix(spec.name.clone());
+        let on_done = |c: &CaseRecord| {
+            if c.status != CaseStatus::Converged {
+                bar.set_message(format!("{} {:?}", c.id, c.status));
+            }
+            bar.inc(1);
+        };
+        let start = Instant::now();
+        let file_name = file.file_name().map_or_else(
+            || file.display().to_string(),
+            |f| f.to_string_lossy().into_owned(),
+        );
+        let run = run_study(&spec, &file_name, tier, &on_done);
+        bar.finish_and_clear();
+        write_outputs(&cli.out, &run)?;
+        let r = &run.results;
+        let failed = r.cases.iter().filter(|c| c.status == CaseStatus::Failed).count();
+        let rejected = r
+            .cases
+            .iter()
+            .filter(|c| c.status == CaseStatus::Rejected)
+            .count();
+        eprintln!(
+            "{}: {} cases ({} failed, {} rejected) solved in {:.2} s on {} threads",
+            spec.name,
+            r.cases.len(),
+            failed,
+            rejected,
+            start.elapsed().as_secs_f64(),
+            r.timing.threads
+        );
+    }
+    let t = Instant::now();
+    let files = report::render_study(&dir)?;
+    let results = read_results(&dir)?;
+    let (pass, fail, none) = results.check_counts();
+    eprintln!(
+        "{}: rendered {} files into {} in {:.2} s; checks: {pass} passed, {fail} failed, {none} not evaluated",
+        spec.name,
+        files.len(),
+        dir.display(),
+        t.elapsed().as_secs_f64()
+    );
+    for r in results.rates.iter().filter(|r| r.pass == Some(false)) {
+        eprintln!(
+            "  rate FAIL: {} {} W={} ppc={:?} {}: slope {:?}, expected {:?}",
+            r.sweep,
+            r.method.name(),
+            r.load,
+            r.points_per_cell,
+            r.measure.name(),
+            r.slope,
+            r.expected.as_ref().map(|b| (b.rate, b.tolerance))
+        );
+    }
+    Ok(fail == 0 && none == 0)
+}
+
+fn main() -> ExitCode {
+    // The studies folder may be given on the command line; peek at it for the help text.
+    let args: Vec<String> = std::env::args().collect();
+    let dir_arg = args
+        .iter()
+        .position(|a| a == "--studies-dir")
+        .and_then(|i| args.get(i + 1))
+        .map(PathBuf::from)
+        .or_else(|| {
+            args.iter()
+                .find_map(|a| a.strip_prefix("--studies-dir=").map(PathBuf::from))
+        });
+    let help_dir = dir_arg.unwrap_or_else(default_studies_dir);
+    let cmd = Cli::command().after_help(studies_help(&help_dir));
+    let cli = match cmd
+        .try_get_matches_from(&args)
+        .and_then(|m| Cli::from_arg_matches(&m))
+    {
+        Ok(c) => c,
+        Err(e) => e.exit(),
+    };
+    let dir = cli.studies_dir.clone().unwrap_or_else(default_studies_dir);
+
+    if cli.studies.iter().any(|s| s == "list") {
+        for entry in catalogue(&dir) {
+            match entry {
+                Ok((name, summary)) => println!("{name:<12} {summary}"),
+                Err(e) => println!("(invalid) {e}"),
+            }
+        }
+        return ExitCode::SUCCESS;
+    }
+    let files: Vec<PathBuf> = if cli.studies.iter().any(|s| s == "all") {
+        match study_files(&dir) {
+            Ok(f) => f,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    } else {
+        cli.studies.iter().map(|s| resolve(&dir, s)).collect()
+    };
+    let mut all_ok = true;
+    for f in &files {
+        match run_one(f, &cli) {
+            Ok(ok) => all_ok &= ok,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+    if let Err(e) = std::fs::create_dir_all(&cli.out)
+        .map_err(|e| StudyError::Io {
+            path: cli.out.display().to_string(),
+            message: e.to_string(),
+        })
+        .and_then(|_| report::render_index(&cli.out))
+    {
+        eprintln!("error: {e}");
+        return ExitCode::FAILURE;
+    }
+    if cli.check && !all_ok {
+        eprintln!("error: some expected rates or comparisons failed or were not evaluated (--check)");
+        return ExitCode::from(2);
+    }
+    ExitCode::SUCCESS
+}

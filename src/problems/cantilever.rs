@@ -78,7 +78,11 @@ impl CantileverSpec {
         require_count("load_steps", self.load_steps, 1)?;
         require_count("points_per_cell", self.points_per_cell, 1)?;
         if self.points_per_cell > 16 {
-            return Err(InputError::new("points_per_cell", self.points_per_cell, "must be <= 16"));
+            return Err(InputError::new(
+                "points_per_cell",
+                self.points_per_cell,
+                "must be <= 16",
+            ));
         }
         self.newton.validate()?;
         LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?;
@@ -125,7 +129,8 @@ impl CantileverSpec {
         let ppc = self.points_per_cell;
         let points = MaterialPoints::fill_box(&grid, [0.0, 0.0], [self.length, self.depth], [ppc, ppc], 1.0)?;
         let axis_y = 0.5 * self.depth;
-        let mut fixed: Vec<(usize, usize)> = grid.nodes_on_plane(0, 0.0).into_iter().map(|n| (n, 0)).collect();
+        let mut fixed: Vec<(usize, usize)> =
+            grid.nodes_on_plane(0, 0.0).into_iter().map(|n| (n, 0)).collect();
         let pin = grid
             .nodes_on_plane(0, 0.0)
             .into_iter()
@@ -134,8 +139,14 @@ impl CantileverSpec {
         fixed.push((pin, 1));
         // End-most column of points; the two nearest the neutral axis.
         let x_end = points.position0.iter().map(|x| x[0]).fold(f64::MIN, f64::max);
-        let mut end: Vec<usize> = (0..points.len()).filter(|&p| (points.position0[p][0] - x_end).abs() < 1e-9).collect();
-        end.sort_by(|&a, &b| (points.position0[a][1] - axis_y).abs().total_cmp(&(points.position0[b][1] - axis_y).abs()));
+        let mut end: Vec<usize> = (0..points.len())
+            .filter(|&p| (points.position0[p][0] - x_end).abs() < 1e-9)
+            .collect();
+        end.sort_by(|&a, &b| {
+            (points.position0[a][1] - axis_y)
+                .abs()
+                .total_cmp(&(points.position0[b][1] - axis_y).abs())
+        });
         let mut loaded = [end[0], end[1]];
         loaded.sort_by(|&a, &b| points.position0[a][1].total_cmp(&points.position0[b][1]));
         let force = SVector::<f64, 2>::new(0.0, -0.5 * self.load);
@@ -152,7 +163,10 @@ impl CantileverSpec {
             weak_node_treatment: self.weak_node_treatment,
         };
         let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
-        Ok((MpmSolver::try_new(grid, points, model, fixed, loads, settings)?, loaded))
+        Ok((
+            MpmSolver::try_new(grid, points, model, fixed, loads, settings)?,
+            loaded,
+        ))
     }
 }
 
@@ -193,7 +207,14 @@ fn snapshot(solver: &MpmSolver<2>, step: usize) -> DomainSnapshot {
     DomainSnapshot {
         step,
         domains: (0..p.len())
-            .map(|i| [p.position[i][0], p.position[i][1], p.half_length[i][0], p.half_length[i][1]])
+            .map(|i| {
+                [
+                    p.position[i][0],
+                    p.position[i][1],
+                    p.half_length[i][0],
+                    p.half_length[i][1],
+                ]
+            })
             .collect(),
     }
 }
@@ -220,7 +241,12 @@ pub fn solve_mpm(spec: &CantileverSpec, snapshot_every: usize) -> Result<Cantile
                     v_over_l: d[1] / spec.length,
                 });
                 out.min_half_length.push(
-                    solver.points.half_length.iter().map(|h| h[0].min(h[1])).fold(f64::INFINITY, f64::min),
+                    solver
+                        .points
+                        .half_length
+                        .iter()
+                        .map(|h| h[0].min(h[1]))
+                        .fold(f64::INFINITY, f64::min),
                 );
                 if snapshot_every > 0 && (r.step % snapshot_every == 0 || r.step == solver.load_steps()) {
                     out.snapshots.push(snapshot(&solver, r.step));

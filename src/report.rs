@@ -1,0 +1,508 @@
+//! Markdown tables, figures and the reports index, rendered from a study's `results.json`
+//! (and, for stress profiles, the point files written beside it) and nothing else, so that
+//! `study --render-only` reproduces them byte for byte.
+
+use crate::plot::{self, ConvergenceSeries, ProfileSeries};
+use crate::problems::column::{ColumnSpec, Method};
+use crate::study::rates::{case_error, pairwise_rates, series};
+use crate::study::runner::{
+    points_file, read_points_csv, read_results, CaseRecord, CaseStatus, StudyResults,
+};
+use crate::study::{uses_material_points, weight_label, FigureKind, FigureSpec, Measure, StudyError};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Human name of a method, as in the paper.
+pub fn method_label(m: Method) -> &'static str {
+    match m {
+        Method::Mpm => "MPM",
+        Method::Igimp => "iGIMP",
+        Method::FemLinear => "linear FEM",
+        Method::FemQuadratic => "quadratic FEM",
+    }
+}
+
+fn series_label(m: Method, ppc: Option<usize>) -> String {
+    match ppc {
+        Some(p) => format!(
+            "{}, {p} point{}/cell",
+            method_label(m),
+            if p == 1 { "" } else { "s" }
+        ),
+        None => method_label(m).to_string(),
+    }
+}
+
+fn e3(x: Option<f64>) -> String {
+    x.map_or("—".into(), |v| format!("{v:.3e}"))
+}
+
+fn rate(x: Option<f64>) -> String {
+    x.map_or("—".into(), |v| format!("{v:.2}"))
+}
+
+fn status_word(c: &CaseRecord) -> &'static str {
+    match c.status {
+        CaseStatus::Converged => "converged",
+        CaseStatus::Failed => "failed",
+        CaseStatus::Rejected => "rejected",
+    }
+}
+
+/// The column of a load (for its analytical solution, `ColumnSpec::analytical`).
+pub fn column_at(results: &StudyResults, load: f64) -> ColumnSpec {
+    let c = &results.study.column;
+    ColumnSpec {
+        length: c.length,
+        young_modulus: c.young_modulus,
+        poisson_ratio: c.poisson_ratio,
+        density: c.density,
+        weight: load,
+        ..ColumnSpec::default()
+    }
+}
+
+/// The (method, points per cell) series of a sweep at one load, in plan order.
+fn sweep_series(results: &StudyResults, sweep_id: &str, load: f64) -> Vec<(Method, Option<usize>)> {
+    let spec = &results.study;
+    let Some(plan) = spec.sweep(sweep_id).and_then(|s| spec.plan(s, results.tier)) else {
+        return vec![];
+    };
+    if !plan.weights.contains(&load) {
+        return vec![];
+    }
+    let mut out = vec![];
+    for &m in &plan.methods {
+        if uses_material_points(m) {
+            out.extend(plan.points_per_cell.iter().map(|&p| (m, Some(p))));
+        } else {
+            out.push((m, None));
+        }
+    }
+    out
+}
+
+fn fitted(
+    results: &StudyResults,
+    sweep: &str,
+    m: Method,
+    load: f64,
+    ppc: Option<usize>,
+    measure: Measure,
+) -> Option<f64> {
+    results
+        .rates
+        .iter()
+        .find(|r| {
+            r.sweep == sweep
+                && r.method == m
+                && r.load == load
+                && r.points_per_cell == ppc
+                && r.measure == measure
+        })
+        .and_then(|r| r.slope)
+}
+
+/// The Markdown report of one study.
+pub fn report_markdown(results: &StudyResults) -> String {
+    let spec = &results.study;
+    let mut s = String::new();
+    let _ = writeln!(s, "# {}: {}\n", spec.name, spec.summary);
+    let _ = writeln!(
+        s,
+        "Rendered from `results.json` by `study` ({} {}, {} tier, study file `{}`); regenerate, do not edit.\n",
+        results.software.name,
+        results.software.version,
+        match results.tier {
+            crate::study::Tier::Full => "full",
+            crate::study::Tier::Quick => "quick",
+        },
+        results.study_file
+    );
+    let (pass, fail, none) = results.check_counts();
+    let _ = writeln!(
+        s,
+        "Checks: {pass} passed, {fail} failed, {none} not evaluated. Cases: {} converged, {} failed, {} rejected.\n",
+        results.cases.iter().filter(|c| c.status == CaseStatus::Converged).count(),
+        results.cases.iter().filter(|c| c.status == CaseStatus::Failed).count(),
+        results.cases.iter().filter(|c| c.status == CaseStatus::Rejected).count(),
+    );
+
+    for p in &spec.paper {
+        let ppc = p.points_per_cell.map(|n| n as usize);
+        let exact = column_at(results, p.weight).analytical();
+        let f0 = exact.deformation_gradient(0.0);
+        let _ = writeln!(
+            s,
+            "## {}: {}, W = {}{}\n",
+            p.table,
+            method_label(p.method),
+            weight_label(p.weight),
+            ppc.map_or(String::new(), |n| format!(", {n} points per cell"))
+        );
+        let _ = writeln!(
+            s,
+            "Analytical: top displacement u(L0) = {:.6}, base F(0) = {:.8} (the paper prints {}). \
+             F error is eq (47); the paper's values match |F − {}| / {} with its rounded F(0), \
+             so both are shown.\n",
+            exact.displacement(results.study.column.length),
+            f0,
+            p.analytical_base_f,
+            p.analytical_base_f,
+            p.analytical_base_f
+        );
+        let ids = results.sweep_cases.of_sweep(&p.sweep);
+        let cases: Vec<Option<&CaseRecord>> = p
+            .elements
+            .iter()
+            .map(|&n| {
+                series(&results.cases, ids, p.method, p.weight, ppc)
+                    .into_iter()
+                    .find(|c| c.elements == n as usize && c.status == CaseStatus::Converged)
+            })
+            .collect();
+        let _ = write!(s, "| number of elements |");
+        for n in &p.elements {
+            let _ = write!(s, " {n} |");
+        }
+        let _ = write!(s, "\n|---|");
+        for _ in &p.elements {
+            let _ = write!(s, "---:|");
+        }
+        s.push('\n');
+        let mut row = |name: &str, f: &dyn Fn(usize, Option<&CaseRecord>) -> String| {
+            let _ = write!(s, "| {name} |");
+            for (i, c) in cases.iter().enumerate() {
+                let _ = write!(s, " {} |", f(i, *c));
+            }
+            s.push('\n');
+        };
+        let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("—".to_string(), f);
+        row("top displacement (m), this code", &|_, c| {
+            opt(c.and_then(|c| c.top_displacement), &|v| format!("{v:.6}"))
+        });
+        row("top displacement (m), paper", &|i, _| {
+            format!("{:.4}", p.top_displacement[i])
+        });
+        row("difference", &|i, c| {
+            opt(c.and_then(|c| c.top_displacement), &|v| {
+                format!("{:+.1e}", v - p.top_displacement[i])
+            })
+        });
+        row("base F, this code", &|_, c| {
+            opt(c.and_then(|c| c.base_f), &|v| format!("{v:.6}"))
+        });
+        row("base F, paper", &|i, _| format!("{:.5}", p.base_f[i]));
+        row("difference", &|i, c| {
+            opt(c.and_then(|c| c.base_f), &|v| format!("{:+.1e}", v - p.base_f[i]))
+        });
+        row("F error vs exact F(0), this code", &|_, c| {
+            opt(c.and_then(|c| c.f_error), &|v| format!("{v:.3e}"))
+        });
+        row(
+            &format!("F error vs F(0) = {}, this code", p.analytical_base_f),
+            &|_, c| {
+                opt(c.and_then(|c| c.base_f), &|v| {
+                    format!("{:.3e}", (v - p.analytical_base_f).abs() / p.analytical_base_f)
+                })
+            },
+        );
+        row("F error, paper", &|i, _| format!("{:.3e}", p.f_error[i]));
+        row("relative difference (rounded F(0) convention)", &|i, c| {
+            opt(c.and_then(|c| c.base_f), &|v| {
+                let e = (v - p.analytical_base_f).abs() / p.analytical_base_f;
+                format!("{:+.1}%", 100.0 * (e - p.f_error[i]) / p.f_error[i])
+            })
+        });
+        s.push('\n');
+    }
+
+    let _ = writeln!(s, "## Convergence\n");
+    let _ = writeln!(
+        s,
+        "Error per refinement with the log2 rate log2(e_coarse/e_fine)/log2(n_fine/n_coarse); the \
+         fitted slope is the least-squares slope of log(error) against log(h) over the finest \
+         element counts listed in the rates table.\n"
+    );
+    for sweep in &spec.sweeps {
+        let Some(plan) = spec.plan(sweep, results.tier) else {
+            continue;
+        };
+        if plan.elements.len() < 2 {
+            continue;
+        }
+        let ids = results.sweep_cases.of_sweep(&sweep.id);
+        let _ = writeln!(s, "### Sweep `{}`: {}\n", sweep.id, sweep.title);
+        for &load in &plan.weights {
+            for (m, ppc) in sweep_series(results, &sweep.id, load) {
+                let cs = series(&results.cases, ids, m, load, ppc);
+                let _ = writeln!(
+                    s,
+                    "**{}, W = {}** (fitted slope: stress {}, F {})\n",
+                    series_label(m, ppc),
+                    weight_label(load),
+                    rate(fitted(results, &sweep.id, m, load, ppc, Measure::StressError)),
+                    rate(fitted(results, &sweep.id, m, load, ppc, Measure::FError)),
+                );
+                let _ = writeln!(
+                    s,
+                    "| elements | stress error | rate | F error | rate | top u | base F | Newton its/step | status |"
+                );
+                let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+                let n: Vec<usize> = cs.iter().map(|c| c.elements).collect();
+                let es: Vec<Option<f64>> = cs.iter().map(|c| case_error(c, Measure::StressError)).collect();
+                let ef: Vec<Option<f64>> = cs.iter().map(|c| case_error(c, Measure::FError)).collect();
+                let (rs, rf) = (pairwise_rates(&n, &es), pairwise_rates(&n, &ef));
+                for (i, c) in cs.iter().enumerate() {
+                    let its = if c.steps.is_empty() {
+                        "—".to_string()
+                    } else {
+                        format!("{:.2}", c.newton_iterations as f64 / c.steps.len() as f64)
+                    };
+                    let _ = writeln!(
+                        s,
+                        "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                        c.elements,
+                        e3(es[i]),
+                        rate(rs[i]),
+                        e3(ef[i]),
+                        rate(rf[i]),
+                        c.top_displacement.map_or("—".into(), |v| format!("{v:.6}")),
+                        c.base_f.map_or("—".into(), |v| format!("{v:.6}")),
+                        its,
+                        status_word(c)
+                    );
+                }
+                s.push('\n');
+            }
+        }
+    }
+
+    let expected: Vec<_> = results.rates.iter().filter(|r| r.expected.is_some()).collect();
+    if !expected.is_empty() {
+        let _ = writeln!(s, "## Expected rates\n");
+        let _ = writeln!(
+            s,
+            "| sweep | series | W | measure | fitted slope | elements fitted | expected | result | source |"
+        );
+        let _ = writeln!(s, "|---|---|---:|---|---:|---|---|---|---|");
+        for r in expected {
+            let b = r.expected.as_ref().expect("filtered");
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} | {} ± {} | {} | {} |",
+                r.sweep,
+                series_label(r.method, r.points_per_cell),
+                weight_label(r.load),
+                r.measure.name(),
+                rate(r.slope),
+                if r.elements_used.is_empty() {
+                    "—".to_string()
+                } else {
+                    format!(
+                        "{}–{}",
+                        r.elements_used[0],
+                        r.elements_used[r.elements_used.len() - 1]
+                    )
+                },
+                b.rate,
+                b.tolerance,
+                pass_word(r.pass),
+                b.source
+            );
+        }
+        s.push('\n');
+    }
+    if !results.comparisons.is_empty() {
+        let _ = writeln!(s, "## Error comparisons\n");
+        let _ = writeln!(
+            s,
+            "| sweep | W | measure | expected | elements checked | largest ratio | result | source |"
+        );
+        let _ = writeln!(s, "|---|---:|---|---|---|---:|---|---|");
+        for c in &results.comparisons {
+            let worst = c
+                .ratios
+                .iter()
+                .copied()
+                .fold(None, |a: Option<f64>, r| Some(a.map_or(r, |a| a.max(r))));
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} below {} | {} | {} | {} | {} |",
+                c.sweep,
+                weight_label(c.load),
+                c.measure.name(),
+                method_label(c.lower),
+                method_label(c.higher),
+                if c.elements_checked.is_empty() {
+                    "—".to_string()
+                } else {
+                    format!("{:?}", c.elements_checked)
+                },
+                worst.map_or("—".into(), |w| format!("{w:.3}")),
+                pass_word(c.pass),
+                c.source
+            );
+        }
+        s.push('\n');
+    }
+    let bad: Vec<&CaseRecord> = results
+        .cases
+        .iter()
+        .filter(|c| c.status != CaseStatus::Converged)
+        .collect();
+    if !bad.is_empty() {
+        let _ = writeln!(s, "## Cases that did not converge\n");
+        let _ = writeln!(s, "| case | status | step | reason |");
+        let _ = writeln!(s, "|---|---|---:|---|");
+        for c in bad {
+            let f = c.failure.as_ref();
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} |",
+                c.id,
+                status_word(c),
+                f.map_or(0, |f| f.step),
+                f.map_or(String::new(), |f| f.reason.replace('|', "/"))
+            );
+        }
+        s.push('\n');
+    }
+    if !spec.figures.is_empty() {
+        let _ = writeln!(s, "## Figures\n");
+        for f in &spec.figures {
+            let _ = writeln!(s, "### {}\n\n![{}]({}.svg)\n", f.title, f.id, f.id);
+        }
+    }
+    s
+}
+
+fn pass_word(p: Option<bool>) -> &'static str {
+    match p {
+        Some(true) => "pass",
+        Some(false) => "FAIL",
+        None => "not run",
+    }
+}
+
+/// Draw one figure of the study (SVG text).
+pub fn render_figure(
+    results: &StudyResults,
+    study_dir: &Path,
+    fig: &FigureSpec,
+) -> Result<String, StudyError> {
+    let ids = results.sweep_cases.of_sweep(&fig.sweep);
+    let file_err = |e: String| StudyError::Io {
+        path: study_dir.join(format!("{}.svg", fig.id)).display().to_string(),
+        message: e,
+    };
+    match fig.kind {
+        FigureKind::Profile => {
+            let mut series_out = vec![];
+            for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {
+                for c in series(&results.cases, ids, m, fig.weight, ppc) {
+                    if c.status != CaseStatus::Converged {
+                        continue;
+                    }
+                    let rows = read_points_csv(&study_dir.join(points_file(&c.id)))?;
+                    series_out.push(ProfileSeries {
+                        label: format!("{}, {} elements", series_label(m, ppc), c.elements),
+                        points: rows.iter().map(|r| (r[3], r[1])).collect(),
+                    });
+                }
+            }
+            let exact = column_at(results, fig.weight).analytical();
+            let l0 = results.study.column.length;
+            let curve: Vec<(f64, f64)> = (0..=200)
+                .map(|i| {
+                    let z0 = l0 * i as f64 / 200.0;
+                    (exact.stress(z0), z0 + exact.displacement(z0))
+                })
+                .collect();
+            plot::profile_svg(
+                &fig.title,
+                "vertical Cauchy stress σzz (Pa)",
+                "current height z (m)",
+                &series_out,
+                &curve,
+            )
+            .map_err(file_err)
+        }
+        FigureKind::Convergence => {
+            let measure = fig.measure.unwrap_or(Measure::StressError);
+            let mut out = vec![];
+            for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {
+                let pts: Vec<(f64, f64)> = series(&results.cases, ids, m, fig.weight, ppc)
+                    .iter()
+                    .filter_map(|c| case_error(c, measure).map(|e| (c.elements as f64, e)))
+                    .collect();
+                if pts.is_empty() {
+                    continue;
+                }
+                out.push(ConvergenceSeries {
+                    label: series_label(m, ppc),
+                    points: pts,
+                    slope: fitted(results, &fig.sweep, m, fig.weight, ppc, measure),
+                });
+            }
+            plot::convergence_svg(&fig.title, measure.label(), &out, fig.slope_triangles).map_err(file_err)
+        }
+    }
+}
+
+/// Render the report and every figure of the study in `study_dir` from its `results.json`.
+/// Returns the files written.
+pub fn render_study(study_dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+    let results = read_results(study_dir)?;
+    let mut written = vec![];
+    let p = study_dir.join(&results.study.report_file);
+    std::fs::write(&p, report_markdown(&results)).map_err(|e| StudyError::io(&p, e))?;
+    written.push(p);
+    for fig in &results.study.figures {
+        let svg = render_figure(&results, study_dir, fig)?;
+        let p = study_dir.join(format!("{}.svg", fig.id));
+        std::fs::write(&p, svg).map_err(|e| StudyError::io(&p, e))?;
+        written.push(p);
+    }
+    Ok(written)
+}
+
+/// Write `<out>/index.md` linking the report and figures of every study folder in `out` that
+/// holds a `results.json`.
+pub fn render_index(out: &Path) -> Result<PathBuf, StudyError> {
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(out)
+        .map_err(|e| StudyError::io(out, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("results.json").is_file())
+        .collect();
+    dirs.sort();
+    let mut s = String::from(
+        "# Reports\n\nGenerated by `cargo run --release --bin study -- all`; every file here is \
+         regenerated by the study runner, never edited by hand.\n\n",
+    );
+    for d in dirs {
+        let results = read_results(&d)?;
+        let name = &results.study.name;
+        let (pass, fail, none) = results.check_counts();
+        let _ = writeln!(s, "## {name}\n\n{}\n", results.study.summary);
+        let _ = writeln!(
+            s,
+            "Tier: {}; checks: {pass} passed, {fail} failed, {none} not evaluated.\n",
+            match results.tier {
+                crate::study::Tier::Full => "full",
+                crate::study::Tier::Quick => "quick",
+            }
+        );
+        let _ = writeln!(s, "- [tables]({name}/{})", results.study.report_file);
+        for f in &results.study.figures {
+            let _ = writeln!(s, "- [{}]({name}/{}.svg)", f.title, f.id);
+        }
+        let _ = writeln!(
+            s,
+            "- [results.json]({name}/results.json) and per-case point files in `{name}/points/`\n"
+        );
+    }
+    let p = out.join("index.md");
+    std::fs::write(&p, s).map_err(|e| StudyError::io(&p, e))?;
+    Ok(p)
+}

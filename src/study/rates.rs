@@ -1,0 +1,260 @@
+//! Convergence rates of the sweeps and the checks declared in the study file.
+//!
+//! A rate is the least-squares slope of log(error) against log(h), h = L0 / elements
+//! ([`crate::norms::fitted_rate`]), over the finest `fit_points` converged element counts of
+//! one series (method, weight, points per cell). Pairwise log2 rates per refinement are
+//! computed by [`pairwise_rates`] for the tables.
+
+use super::runner::{CaseRecord, CaseStatus};
+use super::{uses_material_points, Measure, StudySpec, Tier};
+use crate::norms::fitted_rate;
+use crate::problems::column::Method;
+use serde::{Deserialize, Serialize};
+
+/// The band a fitted rate must fall in, with its source.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ExpectedBand {
+    pub rate: f64,
+    pub tolerance: f64,
+    pub source: String,
+}
+
+/// Fitted rate of one series.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RateRecord {
+    pub sweep: String,
+    pub method: Method,
+    pub load: f64,
+    pub points_per_cell: Option<usize>,
+    pub measure: Measure,
+    /// Slope of log(error) against log(h); `None` with fewer than two converged cases.
+    pub slope: Option<f64>,
+    /// Element counts the fit used.
+    pub elements_used: Vec<usize>,
+    pub expected: Option<ExpectedBand>,
+    /// `None` when nothing is expected, or the series was not run in this tier.
+    pub pass: Option<bool>,
+}
+
+/// Outcome of an `[[compare]]` check.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ComparisonRecord {
+    pub sweep: String,
+    pub load: f64,
+    pub measure: Measure,
+    pub lower: Method,
+    pub higher: Method,
+    /// Element counts where both methods converged.
+    pub elements_checked: Vec<usize>,
+    /// error(lower) / error(higher) at each checked element count.
+    pub ratios: Vec<f64>,
+    /// `None` when no element count could be checked.
+    pub pass: Option<bool>,
+    pub source: String,
+}
+
+/// The error of a case under a measure (converged cases only).
+pub fn case_error(case: &CaseRecord, measure: Measure) -> Option<f64> {
+    if case.status != CaseStatus::Converged {
+        return None;
+    }
+    let e = match measure {
+        Measure::StressError => case.stress_error,
+        Measure::FError => case.f_error,
+    }?;
+    (e.is_finite() && e > 0.0).then_some(e)
+}
+
+/// The converged cases of one series, sorted by element count.
+pub fn series<'a>(
+    cases: &'a [CaseRecord],
+    ids: &[String],
+    method: Method,
+    load: f64,
+    ppc: Option<usize>,
+) -> Vec<&'a CaseRecord> {
+    let mut v: Vec<&CaseRecord> = cases
+        .iter()
+        .filter(|c| ids.contains(&c.id))
+        .filter(|c| c.method == method && c.load == load && c.points_per_cell == ppc)
+        .collect();
+    v.sort_by_key(|c| c.elements);
+    v
+}
+
+/// log2(e_coarse / e_fine) / log2(n_fine / n_coarse) between consecutive entries.
+pub fn pairwise_rates(elements: &[usize], errors: &[Option<f64>]) -> Vec<Option<f64>> {
+    (0..elements.len())
+        .map(|i| {
+            if i == 0 {
+                return None;
+            }
+            let (a, b) = (errors[i - 1]?, errors[i]?);
+            let r = (a / b).log2() / (elements[i] as f64 / elements[i - 1] as f64).log2();
+            r.is_finite().then_some(r)
+        })
+        .collect()
+}
+
+/// Fit every series of every sweep with two or more element counts, then attach the
+/// expectations of the study file.
+pub fn compute_rates(
+    spec: &StudySpec,
+    tier: Tier,
+    cases: &[CaseRecord],
+    case_ids: &CaseIndex,
+) -> Vec<RateRecord> {
+    let mut out = Vec::new();
+    for sweep in &spec.sweeps {
+        let Some(plan) = spec.plan(sweep, tier) else {
+            continue;
+        };
+        if plan.elements.len() < 2 {
+            continue;
+        }
+        let ids = case_ids.of_sweep(&sweep.id);
+        for &method in &plan.methods {
+            let ppcs: Vec<Option<usize>> = if uses_material_points(method) {
+                plan.points_per_cell.iter().map(|&p| Some(p)).collect()
+            } else {
+                vec![None]
+            };
+            for &load in &plan.weights {
+                for &ppc in &ppcs {
+                    let s = series(cases, ids, method, load, ppc);
+                    for measure in [Measure::StressError, Measure::FError] {
+                        let pts: Vec<(usize, f64)> = s
+                            .iter()
+                            .filter_map(|c| case_error(c, measure).map(|e| (c.elements, e)))
+                            .collect();
+                        let n = sweep.fit_points.map_or(pts.len(), |n| n as usize).min(pts.len());
+                        let used = &pts[pts.len() - n..];
+                        let h: Vec<f64> = used.iter().map(|p| spec.column.length / p.0 as f64).collect();
+                        let e: Vec<f64> = used.iter().map(|p| p.1).collect();
+                        out.push(RateRecord {
+                            sweep: sweep.id.clone(),
+                            method,
+                            load,
+                            points_per_cell: ppc,
+                            measure,
+                            slope: fitted_rate(&h, &e),
+                            elements_used: used.iter().map(|p| p.0).collect(),
+                            expected: None,
+                            pass: None,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    for e in &spec.expect {
+        // An expectation on a sweep that this tier leaves out is not listed.
+        let sweep = spec.sweep(&e.sweep).expect("validated");
+        if spec.plan(sweep, tier).is_none() {
+            continue;
+        }
+        let ppc = e.points_per_cell.map(|p| p as usize);
+        let band = ExpectedBand {
+            rate: e.rate,
+            tolerance: e.tolerance,
+            source: e.source.clone(),
+        };
+        let found = out.iter_mut().find(|r| {
+            r.sweep == e.sweep
+                && r.method == e.method
+                && r.load == e.weight
+                && r.points_per_cell == ppc
+                && r.measure == e.measure
+        });
+        match found {
+            Some(r) => {
+                r.pass = Some(r.slope.is_some_and(|s| (s - e.rate).abs() <= e.tolerance));
+                r.expected = Some(band);
+            }
+            None => out.push(RateRecord {
+                sweep: e.sweep.clone(),
+                method: e.method,
+                load: e.weight,
+                points_per_cell: ppc,
+                measure: e.measure,
+                slope: None,
+                elements_used: vec![],
+                expected: Some(band),
+                pass: None,
+            }),
+        }
+    }
+    out
+}
+
+/// Evaluate the `[[compare]]` checks.
+pub fn compute_comparisons(
+    spec: &StudySpec,
+    tier: Tier,
+    cases: &[CaseRecord],
+    case_ids: &CaseIndex,
+) -> Vec<ComparisonRecord> {
+    spec.compare
+        .iter()
+        .filter(|cmp| spec.sweep(&cmp.sweep).and_then(|s| spec.plan(s, tier)).is_some())
+        .map(|cmp| {
+            let sweep = spec.sweep(&cmp.sweep).expect("validated");
+            let mut elements_checked = vec![];
+            let mut ratios = vec![];
+            if let Some(plan) = spec.plan(sweep, tier) {
+                let ids = case_ids.of_sweep(&sweep.id);
+                let pick = |m: Method| -> Vec<&CaseRecord> {
+                    let ppcs: Vec<Option<usize>> = if uses_material_points(m) {
+                        plan.points_per_cell.iter().map(|&p| Some(p)).collect()
+                    } else {
+                        vec![None]
+                    };
+                    ppcs.into_iter()
+                        .flat_map(|p| series(cases, ids, m, cmp.weight, p))
+                        .collect()
+                };
+                let (lo, hi) = (pick(cmp.lower), pick(cmp.higher));
+                for &n in &plan.elements {
+                    let e_hi = hi
+                        .iter()
+                        .find(|c| c.elements == n)
+                        .and_then(|c| case_error(c, cmp.measure));
+                    let Some(e_hi) = e_hi else { continue };
+                    for c in lo.iter().filter(|c| c.elements == n) {
+                        if let Some(e_lo) = case_error(c, cmp.measure) {
+                            elements_checked.push(n);
+                            ratios.push(e_lo / e_hi);
+                        }
+                    }
+                }
+            }
+            ComparisonRecord {
+                sweep: cmp.sweep.clone(),
+                load: cmp.weight,
+                measure: cmp.measure,
+                lower: cmp.lower,
+                higher: cmp.higher,
+                pass: (!ratios.is_empty()).then(|| ratios.iter().all(|&r| r < 1.0)),
+                elements_checked,
+                ratios,
+                source: cmp.source.clone(),
+            }
+        })
+        .collect()
+}
+
+/// Which case ids belong to which sweep (a case may belong to several).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CaseIndex {
+    /// (sweep id, case ids in run order).
+    pub sweeps: Vec<(String, Vec<String>)>,
+}
+
+impl CaseIndex {
+    pub fn of_sweep(&self, id: &str) -> &[String] {
+        self.sweeps
+            .iter()
+            .find(|(s, _)| s == id)
+            .map_or(&[], |(_, v)| v.as_slice())
+    }
+}

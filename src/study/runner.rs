@@ -1,0 +1,349 @@
+//! Runs the cases of a study in parallel and writes `results.json` and the point CSVs.
+//!
+//! Cases are independent, so rayon runs them across threads (largest first, to balance the
+//! load) and the records are put back in the study's case order: the output does not depend
+//! on the thread count. A Newton failure or a point leaving the grid is recorded in the case
+//! (`status = "failed"`, with the failing step and its residual history) and the sweep goes
+//! on; a case the solver rejects as input (e.g. a method not built yet) is `"rejected"`.
+//!
+//! Wall-clock times are the only fields that differ between two runs (`wall_seconds` of each
+//! case and the `timing` block).
+
+use super::rates::{compute_comparisons, compute_rates, CaseIndex, ComparisonRecord, RateRecord};
+use super::{Case, StudyError, StudySpec, Tier};
+use crate::newton::NewtonSettings;
+use crate::problems::column::{solve_column, Method, PointRecord};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Header of the per-case point files.
+pub const POINTS_HEADER: &str = "z0,z,volume0,sigma_zz,f_zz";
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CaseStatus {
+    /// Every load step converged.
+    Converged,
+    /// A load step failed (see `failure`); errors are not reported.
+    Failed,
+    /// The solver refused the input (see `failure.reason`); nothing was solved.
+    Rejected,
+}
+
+/// Newton residual history of one converged load step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StepRecord {
+    pub step: usize,
+    pub load_factor: f64,
+    /// Normalised out-of-balance force before the first and after each Newton update.
+    pub residuals: Vec<f64>,
+}
+
+/// Why a case did not converge.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FailureRecord {
+    /// Load step that failed (from 1); 0 when the input was rejected.
+    pub step: usize,
+    pub reason: String,
+    /// Residual history of the failing step.
+    pub residuals: Vec<f64>,
+}
+
+/// Result of one case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseRecord {
+    pub id: String,
+    pub method: Method,
+    /// Total weight W.
+    pub load: f64,
+    pub elements: usize,
+    /// `None` (null) for FEM.
+    pub points_per_cell: Option<usize>,
+    pub load_steps: usize,
+    pub newton: NewtonSettings,
+    pub status: CaseStatus,
+    pub failure: Option<FailureRecord>,
+    /// Eq (46), converged cases only.
+    pub stress_error: Option<f64>,
+    /// Eq (47) against the exact analytical base F, converged cases only.
+    pub f_error: Option<f64>,
+    pub top_displacement: Option<f64>,
+    pub base_f: Option<f64>,
+    /// Number of material or Gauss points (rows of the point file).
+    pub points: usize,
+    /// Newton iterations summed over the converged steps.
+    pub newton_iterations: usize,
+    pub steps: Vec<StepRecord>,
+    pub wall_seconds: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Software {
+    pub name: String,
+    pub version: String,
+}
+
+/// Wall-clock data: the only part of `results.json` that changes from run to run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Timing {
+    pub wall_seconds: f64,
+    pub threads: usize,
+}
+
+/// Everything the renderers need: `results.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StudyResults {
+    pub software: Software,
+    /// File name of the study file the inputs came from.
+    pub study_file: String,
+    pub tier: Tier,
+    /// The study inputs as parsed.
+    pub study: StudySpec,
+    /// Case ids of each sweep.
+    pub sweep_cases: CaseIndex,
+    pub cases: Vec<CaseRecord>,
+    pub rates: Vec<RateRecord>,
+    pub comparisons: Vec<ComparisonRecord>,
+    pub timing: Timing,
+}
+
+impl StudyResults {
+    pub fn case(&self, id: &str) -> Option<&CaseRecord> {
+        self.cases.iter().find(|c| c.id == id)
+    }
+
+    /// Copy with every wall-clock field zeroed, for comparing two runs.
+    pub fn without_timing(&self) -> Self {
+        let mut r = self.clone();
+        r.timing = Timing {
+            wall_seconds: 0.0,
+            threads: 0,
+        };
+        r.cases.iter_mut().for_each(|c| c.wall_seconds = 0.0);
+        r
+    }
+
+    /// Rates and comparisons with an expectation: (passed, failed, not evaluated).
+    pub fn check_counts(&self) -> (usize, usize, usize) {
+        let passes = self
+            .rates
+            .iter()
+            .filter(|r| r.expected.is_some())
+            .map(|r| r.pass)
+            .chain(self.comparisons.iter().map(|c| c.pass));
+        let mut n = (0, 0, 0);
+        for p in passes {
+            match p {
+                Some(true) => n.0 += 1,
+                Some(false) => n.1 += 1,
+                None => n.2 += 1,
+            }
+        }
+        n
+    }
+}
+
+/// A solved study: the results and the final point values of each case (same order).
+#[derive(Debug, Clone)]
+pub struct StudyRun {
+    pub results: StudyResults,
+    pub points: Vec<Vec<PointRecord>>,
+}
+
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+/// Solve one case.
+pub fn run_case(case: &Case) -> (CaseRecord, Vec<PointRecord>) {
+    let start = Instant::now();
+    let mut rec = CaseRecord {
+        id: case.id.clone(),
+        method: case.method,
+        load: case.spec.weight,
+        elements: case.spec.elements,
+        points_per_cell: case.points_per_cell,
+        load_steps: case.spec.load_steps,
+        newton: case.spec.newton,
+        status: CaseStatus::Rejected,
+        failure: None,
+        stress_error: None,
+        f_error: None,
+        top_displacement: None,
+        base_f: None,
+        points: 0,
+        newton_iterations: 0,
+        steps: vec![],
+        wall_seconds: 0.0,
+    };
+    let points = match solve_column(&case.spec, case.method) {
+        Err(e) => {
+            rec.failure = Some(FailureRecord {
+                step: 0,
+                reason: e.to_string(),
+                residuals: vec![],
+            });
+            vec![]
+        }
+        Ok(out) => {
+            rec.steps = out
+                .steps
+                .iter()
+                .map(|s| StepRecord {
+                    step: s.step,
+                    load_factor: s.load_factor,
+                    residuals: s.newton.residuals.clone(),
+                })
+                .collect();
+            rec.newton_iterations = out.steps.iter().map(|s| s.newton.iterations()).sum();
+            rec.points = out.points.len();
+            match &out.failure {
+                Some(f) => {
+                    rec.status = CaseStatus::Failed;
+                    rec.failure = Some(FailureRecord {
+                        step: f.step,
+                        reason: f.failure.to_string(),
+                        residuals: f.residuals.clone(),
+                    });
+                }
+                None => {
+                    rec.status = CaseStatus::Converged;
+                    rec.stress_error = finite(out.stress_error);
+                    rec.f_error = finite(out.f_error);
+                    rec.top_displacement = finite(out.top_displacement);
+                    rec.base_f = finite(out.base_f);
+                }
+            }
+            out.points
+        }
+    };
+    rec.wall_seconds = start.elapsed().as_secs_f64();
+    (rec, points)
+}
+
+/// Solve every case of the tier. `on_case_done` is called (from worker threads) after each
+/// case, e.g. to advance a progress bar.
+pub fn run_study(
+    spec: &StudySpec,
+    study_file: &str,
+    tier: Tier,
+    on_case_done: &(dyn Fn(&CaseRecord) + Sync),
+) -> StudyRun {
+    let start = Instant::now();
+    let cases = spec.cases(tier);
+    // Largest cases first so that the last one to start is short.
+    let mut order: Vec<usize> = (0..cases.len()).collect();
+    let cost = |c: &Case| c.spec.elements * c.points_per_cell.unwrap_or(3) * c.spec.load_steps;
+    order.sort_by_key(|&i| std::cmp::Reverse(cost(&cases[i])));
+    let mut solved: Vec<(usize, CaseRecord, Vec<PointRecord>)> = order
+        .par_iter()
+        .map(|&i| {
+            let (rec, pts) = run_case(&cases[i]);
+            on_case_done(&rec);
+            (i, rec, pts)
+        })
+        .collect();
+    solved.sort_by_key(|s| s.0);
+    let (records, points): (Vec<CaseRecord>, Vec<Vec<PointRecord>>) =
+        solved.into_iter().map(|(_, r, p)| (r, p)).unzip();
+    let index = spec.case_index(tier);
+    let rates = compute_rates(spec, tier, &records, &index);
+    let comparisons = compute_comparisons(spec, tier, &records, &index);
+    StudyRun {
+        results: StudyResults {
+            software: Software {
+                name: env!("CARGO_PKG_NAME").to_string(),
+                version: env!("CARGO_PKG_VERSION").to_string(),
+            },
+            study_file: study_file.to_string(),
+            tier,
+            study: spec.clone(),
+            sweep_cases: index,
+            cases: records,
+            rates,
+            comparisons,
+            timing: Timing {
+                wall_seconds: start.elapsed().as_secs_f64(),
+                threads: rayon::current_num_threads(),
+            },
+        },
+        points,
+    }
+}
+
+/// Folder of a study's outputs: `<out>/<name>`.
+pub fn study_dir(out: &Path, name: &str) -> PathBuf {
+    out.join(name)
+}
+
+/// Points file of a case, relative to the study folder.
+pub fn points_file(case_id: &str) -> String {
+    format!("points/{case_id}.csv")
+}
+
+/// One row per point, shortest round-trip formatting (so the file re-reads exactly).
+pub fn points_csv(points: &[PointRecord]) -> String {
+    let mut s = String::with_capacity(64 * (points.len() + 1));
+    s.push_str(POINTS_HEADER);
+    s.push('\n');
+    for p in points {
+        s.push_str(&format!(
+            "{},{},{},{},{}\n",
+            p.z0, p.z, p.volume0, p.sigma_zz, p.f_zz
+        ));
+    }
+    s
+}
+
+/// Parse a points file written by [`points_csv`]: rows of (z0, z, volume0, sigma_zz, f_zz).
+pub fn read_points_csv(path: &Path) -> Result<Vec<[f64; 5]>, StudyError> {
+    let text = std::fs::read_to_string(path).map_err(|e| StudyError::io(path, e))?;
+    let mut lines = text.lines();
+    if lines.next() != Some(POINTS_HEADER) {
+        return Err(StudyError::io(path, format!("header must be `{POINTS_HEADER}`")));
+    }
+    lines
+        .enumerate()
+        .map(|(i, l)| {
+            let v: Vec<f64> = l.split(',').filter_map(|x| x.parse().ok()).collect();
+            <[f64; 5]>::try_from(v)
+                .map_err(|_| StudyError::io(path, format!("line {}: expected 5 numbers", i + 2)))
+        })
+        .collect()
+}
+
+/// Write `results.json` and `points/*.csv` (stale point files of earlier runs are removed).
+pub fn write_outputs(out: &Path, run: &StudyRun) -> Result<PathBuf, StudyError> {
+    let dir = study_dir(out, &run.results.study.name);
+    let pdir = dir.join("points");
+    std::fs::create_dir_all(&pdir).map_err(|e| StudyError::io(&pdir, e))?;
+    for entry in std::fs::read_dir(&pdir).map_err(|e| StudyError::io(&pdir, e))? {
+        let p = entry.map_err(|e| StudyError::io(&pdir, e))?.path();
+        if p.extension().is_some_and(|x| x == "csv") {
+            std::fs::remove_file(&p).map_err(|e| StudyError::io(&p, e))?;
+        }
+    }
+    for (case, pts) in run.results.cases.iter().zip(&run.points) {
+        if case.status == CaseStatus::Rejected {
+            continue;
+        }
+        let p = dir.join(points_file(&case.id));
+        std::fs::write(&p, points_csv(pts)).map_err(|e| StudyError::io(&p, e))?;
+    }
+    let json = serde_json::to_string_pretty(&run.results).map_err(|e| StudyError::io(&dir, e))?;
+    let p = dir.join("results.json");
+    std::fs::write(&p, json + "\n").map_err(|e| StudyError::io(&p, e))?;
+    Ok(dir)
+}
+
+/// Read a study's `results.json`.
+pub fn read_results(study_dir: &Path) -> Result<StudyResults, StudyError> {
+    let p = study_dir.join("results.json");
+    let text = std::fs::read_to_string(&p).map_err(|e| StudyError::io(&p, e))?;
+    serde_json::from_str(&text).map_err(|e| StudyError::Parse {
+        file: p.display().to_string(),
+        message: e.to_string(),
+    })
+}
