@@ -7,8 +7,13 @@ fn main() {
         Some("f-diagonal") => DomainUpdate::FDiagonal,
         _ => DomainUpdate::Stretch,
     };
+    let volume_update = match std::env::args().nth(2).as_deref() {
+        Some("domain") => igimp::mpm::VolumeUpdate::DomainProduct,
+        _ => igimp::mpm::VolumeUpdate::Jacobian,
+    };
     let spec = CantileverSpec {
         domain_update: update,
+        volume_update,
         ..CantileverSpec::default()
     };
     let t = std::time::Instant::now();

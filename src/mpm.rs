@@ -39,6 +39,22 @@ pub struct MpmSettings {
     pub weak_node_tolerance: f64,
     #[serde(default)]
     pub weak_node_treatment: WeakNodeTreatment,
+    #[serde(default)]
+    pub volume_update: VolumeUpdate,
+}
+
+/// How the committed volume V_p^n of a material point is obtained (eq 28).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum VolumeUpdate {
+    /// V_p^n = det(F) v_p0, accumulated as det(ΔF) V_p^(n−1): conserves mass under any
+    /// deformation, and keeps the volume independent of the domain-update rule.
+    #[default]
+    Jacobian,
+    /// V_p^n = Π l_i, the product of the updated domain lengths, as §3.1 states. Equal to
+    /// the Jacobian in 1D; with the F-diagonal domain update it collapses under rotation,
+    /// which is how the paper's Figure 20(a) analysis fails.
+    DomainProduct,
 }
 
 /// How weak nodes are treated in a load step.
@@ -175,9 +191,15 @@ impl<const D: usize> MpmSolver<D> {
                     &self.points.half_length[p],
                     &mut sup,
                 )
-                .map_err(|e| StepFailure::LeftGrid {
-                    point: p,
-                    position: format!("{:?}: {e}", self.points.position[p].as_slice()),
+                .map_err(|e| match e {
+                    crate::basis::BasisError::DegenerateDomain { .. } => StepFailure::Kinematics {
+                        point: p,
+                        reason: format!("{e} (half-lengths {:?})", self.points.half_length[p].as_slice()),
+                    },
+                    _ => StepFailure::LeftGrid {
+                        point: p,
+                        position: format!("{:?}: {e}", self.points.position[p].as_slice()),
+                    },
                 })?;
             for k in 0..sup.len() {
                 let (node, s, g) = sup.node(&self.grid, k);
@@ -280,6 +302,11 @@ impl<const D: usize> MpmSolver<D> {
                 DomainUpdate::FDiagonal => SVector::<f64, D>::from_fn(|a, _| r0[a] * f[(a, a)]),
                 DomainUpdate::Fixed => r0,
             };
+            if self.settings.volume_update == VolumeUpdate::DomainProduct {
+                // The paper's V_p^n: the product of the domain lengths (unit out-of-plane).
+                let h = self.points.half_length[p];
+                self.points.state[p].volume = (0..D).map(|a| 2.0 * h[a]).product();
+            }
         }
     }
 }

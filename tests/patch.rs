@@ -28,6 +28,7 @@ fn patch<const D: usize>(
         load_steps: 1,
         weak_node_tolerance: 0.0,
         weak_node_treatment: Default::default(),
+        volume_update: Default::default(),
     };
     let loads = Loads {
         gravity: SVector::<f64, D>::zeros(),

@@ -190,6 +190,7 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
             load_steps: 1,
             weak_node_tolerance: 0.0,
             weak_node_treatment: Default::default(),
+            volume_update: Default::default(),
         };
         let loads = Loads {
             gravity: SVector::<f64, 2>::zeros(),

@@ -11,7 +11,7 @@ use crate::basis::Basis;
 use crate::constitutive::LinearElastic;
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::grid::Grid;
-use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, WeakNodeTreatment};
+use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, VolumeUpdate, WeakNodeTreatment};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::particles::MaterialPoints;
 use nalgebra::SVector;
@@ -44,6 +44,11 @@ pub struct CantileverSpec {
     pub weak_node_tolerance: f64,
     #[serde(default)]
     pub weak_node_treatment: WeakNodeTreatment,
+    /// Point volume rule. Default: the paper's product of the domain lengths (§3.1), under
+    /// which the F-diagonal update collapses (Figure 20a); with `jacobian` volumes the
+    /// F-diagonal run completes although its domains shrink to a fraction of their size.
+    #[serde(default)]
+    pub volume_update: VolumeUpdate,
 }
 
 impl Default for CantileverSpec {
@@ -63,6 +68,7 @@ impl Default for CantileverSpec {
             newton: NewtonSettings::default(),
             weak_node_tolerance: 2e-2,
             weak_node_treatment: WeakNodeTreatment::Tie,
+            volume_update: VolumeUpdate::DomainProduct,
         }
     }
 }
@@ -161,6 +167,7 @@ impl CantileverSpec {
             load_steps: self.load_steps,
             weak_node_tolerance: self.weak_node_tolerance,
             weak_node_treatment: self.weak_node_treatment,
+            volume_update: self.volume_update,
         };
         let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
         Ok((

@@ -399,6 +399,7 @@ impl ColumnSpec {
             load_steps: self.load_steps,
             weak_node_tolerance: 0.0,
             weak_node_treatment: Default::default(),
+            volume_update: Default::default(),
         };
         MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, settings)
     }

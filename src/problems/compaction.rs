@@ -156,6 +156,7 @@ impl CompactionSpec {
             load_steps: self.load_steps,
             weak_node_tolerance: self.weak_node_tolerance,
             weak_node_treatment: self.weak_node_treatment,
+            volume_update: Default::default(),
         };
         MpmSolver::try_new(grid, points, self.model()?, fixed, loads, settings)
     }
