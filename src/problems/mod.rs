@@ -3,3 +3,4 @@
 pub mod cantilever;
 pub mod column;
 pub mod compaction;
+pub mod elastica;
