@@ -41,17 +41,23 @@
 //! Gauss points the error is O(h²). The paper states both facts (§5.1); the tests pin them.
 
 mod line;
+mod plane;
+mod quad;
+mod updated_lagrangian;
 
 pub use line::{LineElement, LineMesh, MAX_LINE_NODES};
+pub use plane::{PlaneFem, PlaneFemSettings, PlaneLoads};
+pub use quad::{PlaneMesh, QuadElement, MAX_QUAD_NODES};
+pub use updated_lagrangian::{validate_stepping, GaussPoints, MAX_LOAD_STEPS};
 
-use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
+use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
-use crate::error::{require_count, require_finite, InputError, SolveError, StepFailure};
-use crate::kinematics::PointState;
+use crate::error::{require_finite, InputError, SolveError, StepFailure};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::problems::column::{ColumnOutcome, ColumnSpec, PointRecord};
 use crate::quadrature::GaussRule;
 use nalgebra::SVector;
+use updated_lagrangian::{FullLoads, UlCore};
 
 /// Settings of a [`LineFem`] analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -66,16 +72,7 @@ pub struct LineFemSettings {
 impl LineFemSettings {
     pub fn validate(&self) -> Result<(), InputError> {
         GaussRule::try_new(self.gauss_points)?;
-        self.newton.validate()?;
-        require_count("load_steps", self.load_steps, 1)?;
-        if self.load_steps > 1_000_000 {
-            return Err(InputError::new(
-                "load_steps",
-                self.load_steps,
-                "must be <= 1000000",
-            ));
-        }
-        Ok(())
+        validate_stepping(&self.newton, self.load_steps)
     }
 }
 
@@ -88,32 +85,6 @@ pub struct LineLoads {
     pub nodal_forces: Vec<(usize, f64)>,
 }
 
-/// The Gauss points of a [`LineFem`], element by element (point `p = e * n_q + q`).
-#[derive(Debug, Clone, Default)]
-pub struct GaussPoints {
-    /// Element of each point.
-    pub element: Vec<usize>,
-    /// Local coordinate ξ_q.
-    pub xi: Vec<f64>,
-    /// Initial position X(ξ_q).
-    pub position0: Vec<f64>,
-    /// Initial volume (length) w_q det(∂X/∂ξ)|₀.
-    pub volume0: Vec<f64>,
-    /// Mass ρ0 w_q det(∂X/∂ξ)|₀.
-    pub mass: Vec<f64>,
-    /// Committed F, volume and constitutive state.
-    pub state: Vec<PointState>,
-}
-
-impl GaussPoints {
-    pub fn len(&self) -> usize {
-        self.xi.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.xi.is_empty()
-    }
-}
-
 /// Implicit updated-Lagrangian FEM on a line mesh.
 pub struct LineFem {
     /// Initial mesh.
@@ -121,16 +92,12 @@ pub struct LineFem {
     /// Current mesh (nodes moved with the material).
     pub mesh: LineMesh,
     pub gauss: GaussPoints,
-    model: Box<dyn ConstitutiveModel>,
     /// Nodes with zero displacement.
     pub fixed: Vec<usize>,
     pub loads: LineLoads,
     pub settings: LineFemSettings,
     rule: GaussRule,
-    step: usize,
-    /// Nodal dofs fixed at zero, as (node, axis).
-    fixed_dofs: Vec<(usize, usize)>,
-    work: StepWorkspace<1>,
+    core: UlCore<1>,
 }
 
 impl LineFem {
@@ -171,27 +138,19 @@ impl LineFem {
             let x = mesh.element_coordinates(e);
             for (&xi, &w) in rule.points().iter().zip(rule.weights()) {
                 let (pos, jac) = mesh.element.map(&x[..k], xi);
-                let v0 = w * jac;
-                gauss.element.push(e);
-                gauss.xi.push(xi);
-                gauss.position0.push(pos);
-                gauss.volume0.push(v0);
-                gauss.mass.push(density * v0);
-                gauss.state.push(PointState::undeformed(v0));
+                gauss.push(e, xi, pos, w * jac, density);
             }
         }
+        let fixed_dofs = fixed.iter().map(|&n| (n, 0)).collect();
         Ok(Self {
             mesh0: mesh.clone(),
             mesh,
             gauss,
-            model,
-            fixed: fixed.clone(),
+            fixed,
             loads,
             settings,
             rule,
-            step: 0,
-            fixed_dofs: fixed.iter().map(|&n| (n, 0)).collect(),
-            work: StepWorkspace::default(),
+            core: UlCore::new(model, fixed_dofs),
         })
     }
 
@@ -203,34 +162,17 @@ impl LineFem {
     /// Fill the support table: for each Gauss point its element's nodes, N_a(ξ_q) and
     /// ∂N_a/∂X̃ = (dX̃/dξ)⁻¹ dN_a/dξ on the current mesh (eqs 33–34).
     pub fn build_supports(&mut self) -> Result<(), StepFailure> {
-        let element = self.mesh.element;
-        let k = element.nodes_per_element();
-        self.work.table.clear();
-        for p in 0..self.gauss.len() {
-            let e = self.gauss.element[p];
-            let x = self.mesh.element_coordinates(e);
-            let (n, dn) = element.shape(self.gauss.xi[p]);
-            let (_, jac) = element.map(&x[..k], self.gauss.xi[p]);
-            if !(jac > 0.0 && jac.is_finite()) {
-                return Err(StepFailure::Kinematics {
-                    point: p,
-                    reason: format!("element {e} has dX/dξ = {jac:e} <= 0 at its Gauss point"),
-                });
-            }
-            let first = self.mesh.first_node(e);
-            for a in 0..k {
-                self.work
-                    .table
-                    .push_node(first + a, n[a], SVector::<f64, 1>::new(dn[a] / jac));
-            }
-            self.work.table.finish_point();
-        }
-        Ok(())
+        line_supports(
+            &self.mesh,
+            &self.gauss.element,
+            &self.gauss.xi,
+            &mut self.core.work.table,
+        )
     }
 
     /// Supports of the last [`Self::build_supports`].
     pub fn supports(&self) -> &SupportTable<1> {
-        &self.work.table
+        &self.core.work.table
     }
 
     /// Set up the nonlinear system of a load step at `load_factor` on the current mesh and
@@ -242,37 +184,13 @@ impl LineFem {
         f: impl FnOnce(&mut LoadStepSystem<'_, 1>) -> R,
     ) -> Result<R, StepFailure> {
         self.build_supports()?;
-        let forces: Vec<SVector<f64, 1>> = self
-            .gauss
-            .mass
-            .iter()
-            .map(|&m| SVector::<f64, 1>::new(m * self.loads.gravity * load_factor))
-            .collect();
-        let nodal: Vec<(usize, f64)> = self
-            .loads
-            .nodal_forces
-            .iter()
-            .map(|&(n, force)| (n, force * load_factor))
-            .collect();
-        let input = StepInput {
-            model: self.model.as_ref(),
-            states: &self.gauss.state,
-            num_nodes: self.mesh.num_nodes(),
-            fixed: &self.fixed_dofs,
-            point_forces: &forces,
-            nodal_forces: &nodal,
-        };
-        Ok(self.work.with_system(&input, f))
-    }
-
-    /// Commit the converged step: Gauss point states and node positions x = X̃ + Δu.
-    fn commit(&mut self) {
-        for (state, new) in self.gauss.state.iter_mut().zip(self.work.committed_states()) {
-            *state = new;
-        }
-        for (x, du) in self.mesh.nodes.iter_mut().zip(&self.work.du_nodal) {
-            *x += du;
-        }
+        let loads = line_loads(&self.loads, &self.gauss.mass);
+        let n = self.mesh.num_nodes();
+        Ok(self
+            .core
+            .with_input(&self.gauss.state, n, &loads, load_factor, |work, input| {
+                work.with_system(input, f)
+            }))
     }
 
     /// Current position x(ξ_q) and Jacobian dx/dξ of Gauss point `p` on the current mesh.
@@ -288,33 +206,64 @@ impl LineFem {
     }
 }
 
+/// The loads of a line mesh: in 1D a node's dof is the node.
+fn line_loads<'a>(loads: &'a LineLoads, mass: &'a [f64]) -> FullLoads<'a, 1> {
+    FullLoads {
+        gravity: SVector::<f64, 1>::new(loads.gravity),
+        mass,
+        dof_forces: &loads.nodal_forces,
+    }
+}
+
+/// Line-element supports on the current mesh (see [`LineFem::build_supports`]).
+fn line_supports(
+    mesh: &LineMesh,
+    elements: &[usize],
+    xis: &[f64],
+    table: &mut SupportTable<1>,
+) -> Result<(), StepFailure> {
+    let element = mesh.element;
+    let k = element.nodes_per_element();
+    table.clear();
+    for (p, (&e, &xi)) in elements.iter().zip(xis).enumerate() {
+        let x = mesh.element_coordinates(e);
+        let (n, dn) = element.shape(xi);
+        let (_, jac) = element.map(&x[..k], xi);
+        if !(jac > 0.0 && jac.is_finite()) {
+            return Err(StepFailure::Kinematics {
+                point: p,
+                reason: format!("element {e} has dX/dξ = {jac:e} <= 0 at its Gauss point"),
+            });
+        }
+        let first = mesh.first_node(e);
+        for a in 0..k {
+            table.push_node(first + a, n[a], SVector::<f64, 1>::new(dn[a] / jac));
+        }
+        table.finish_point();
+    }
+    Ok(())
+}
+
 impl LoadStepping for LineFem {
     fn step(&mut self) -> Result<StepReport, SolveError> {
-        let step = self.step + 1;
-        let fail = |failure, residuals| SolveError {
-            step,
-            failure,
-            residuals,
-        };
-        let load_factor = step as f64 / self.settings.load_steps as f64;
-        let newton_settings = self.settings.newton;
-        let report = self
-            .with_step_system(load_factor, |system| {
-                let mut u = vec![0.0; crate::newton::NonlinearSystem::num_unknowns(system)];
-                crate::newton::solve(system, &mut u, &newton_settings)
-            })
-            .map_err(|f| fail(f, vec![]))?
-            .map_err(|(f, r)| fail(f, r))?;
-        self.commit();
-        self.step = step;
-        Ok(StepReport {
-            step,
-            load_factor,
-            newton: report,
-        })
+        let loads = line_loads(&self.loads, &self.gauss.mass);
+        let (mesh, states) = (&self.mesh, &mut self.gauss.state);
+        let (elements, xis) = (&self.gauss.element, &self.gauss.xi);
+        let report = self.core.step(
+            &self.settings.newton,
+            self.settings.load_steps,
+            states,
+            mesh.num_nodes(),
+            &loads,
+            |table| line_supports(mesh, elements, xis, table),
+        )?;
+        // Updated Lagrangian: the converged configuration is the next reference.
+        let du = &self.core.work.du_nodal;
+        self.mesh.nodes.iter_mut().zip(du).for_each(|(x, d)| *x += d);
+        Ok(report)
     }
     fn steps_done(&self) -> usize {
-        self.step
+        self.core.step
     }
     fn load_steps(&self) -> usize {
         self.settings.load_steps
