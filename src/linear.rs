@@ -192,48 +192,112 @@ impl SparseSystem {
         self.factor.resize(symbolic.len_val(), 0.0);
         let par = faer::get_global_parallelism();
         let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
-        let solve_scratch = symbolic.solve_in_place_scratch::<f64>(1, par);
-        match self.solver {
-            LinearSolver::Ldlt => {
-                let scratch = symbolic
-                    .factorize_numeric_ldlt_scratch::<f64>(par, Default::default())
-                    .or(solve_scratch);
-                let mut buf = MemBuffer::try_new(scratch).map_err(|e| format!("{e:?}"))?;
-                let stack = MemStack::new(&mut buf);
-                symbolic
-                    .factorize_numeric_ldlt(
-                        &mut self.factor,
-                        mat,
-                        Side::Lower,
-                        Default::default(),
-                        par,
-                        &mut *stack,
-                        Default::default(),
-                    )
-                    .map_err(|e| format!("{e:?}"))?;
-                LdltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, rhs, par, stack);
-            }
-            LinearSolver::Llt => {
-                let scratch = symbolic
-                    .factorize_numeric_llt_scratch::<f64>(par, Default::default())
-                    .or(solve_scratch);
-                let mut buf = MemBuffer::try_new(scratch).map_err(|e| format!("{e:?}"))?;
-                let stack = MemStack::new(&mut buf);
-                symbolic
-                    .factorize_numeric_llt(
-                        &mut self.factor,
-                        mat,
-                        Side::Lower,
-                        Default::default(),
-                        par,
-                        &mut *stack,
-                        Default::default(),
-                    )
-                    .map_err(|e| format!("{e:?}"))?;
-                LltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, rhs, par, stack);
-            }
+        let ldlt = match self.solver {
+            LinearSolver::Ldlt => true,
+            LinearSolver::Llt => false,
             LinearSolver::Lu => unreachable!("LU is not a symmetric factorisation"),
+        };
+        let factor_scratch = if ldlt {
+            symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default())
+        } else {
+            symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default())
+        };
+        let scratch = factor_scratch.or(symbolic.solve_in_place_scratch::<f64>(1, par));
+        let mut buf = MemBuffer::try_new(scratch).map_err(|e| format!("{e:?}"))?;
+        let stack = MemStack::new(&mut buf);
+        let (side, reg) = (Side::Lower, Default::default());
+        if ldlt {
+            symbolic
+                .factorize_numeric_ldlt(&mut self.factor, mat, side, reg, par, stack, Default::default())
+                .map_err(|e| format!("{e:?}"))?;
+            LdltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, rhs, par, stack);
+        } else {
+            let reg = Default::default();
+            symbolic
+                .factorize_numeric_llt(&mut self.factor, mat, side, reg, par, stack, Default::default())
+                .map_err(|e| format!("{e:?}"))?;
+            LltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, rhs, par, stack);
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 5-point Laplacian on an m × m grid plus `shift` on the diagonal (SPD for shift > −λ_min).
+    fn laplacian(m: usize, shift: f64) -> SparseSystem {
+        let n = m * m;
+        let id = |i: usize, j: usize| j * m + i;
+        let mut columns = vec![Vec::new(); n];
+        let mut entries = Vec::new();
+        for j in 0..m {
+            for i in 0..m {
+                let c = id(i, j);
+                entries.push((c, c, 4.0 + shift));
+                let mut near = vec![];
+                if i > 0 {
+                    near.push(id(i - 1, j));
+                }
+                if i + 1 < m {
+                    near.push(id(i + 1, j));
+                }
+                if j > 0 {
+                    near.push(id(i, j - 1));
+                }
+                if j + 1 < m {
+                    near.push(id(i, j + 1));
+                }
+                for r in near {
+                    entries.push((r, c, -1.0));
+                }
+            }
+        }
+        for &(r, c, _) in &entries {
+            columns[c].push(r);
+        }
+        let mut sys = SparseSystem::default();
+        sys.set_pattern(columns);
+        for (r, c, v) in entries {
+            sys.add(r, c, v);
+        }
+        sys
+    }
+
+    fn solve(sys: &mut SparseSystem, solver: LinearSolver, rhs: &[f64]) -> Vec<f64> {
+        sys.set_solver(solver);
+        let mut x = rhs.to_vec();
+        sys.solve_in_place(&mut x).unwrap();
+        x
+    }
+
+    /// LDLᵀ and LLᵀ give the LU solution of an SPD system (to round-off, also on a second
+    /// solve that reuses the cached symbolic analysis); on a symmetric indefinite system LLᵀ
+    /// fails and falls back to LU, while LDLᵀ still solves it (the shift avoids the exact zero
+    /// pivots an integer indefinite matrix can produce without pivoting).
+    #[test]
+    fn symmetric_factorisations_match_lu() {
+        for (shift, definite) in [(0.5, true), (-4.877, false)] {
+            let mut sys = laplacian(12, shift);
+            let n = sys.dim();
+            let rhs: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
+            let lu = solve(&mut sys, LinearSolver::Lu, &rhs);
+            let scale = lu.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for solver in [LinearSolver::Ldlt, LinearSolver::Llt] {
+                for _ in 0..2 {
+                    let before = sys.fallbacks();
+                    let x = solve(&mut sys, solver, &rhs);
+                    let err = x.iter().zip(&lu).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                    assert!(err < 1e-12 * scale, "{solver:?} shift {shift}: {err:e}");
+                    let fell_back = sys.fallbacks() > before;
+                    assert_eq!(
+                        fell_back,
+                        solver == LinearSolver::Llt && !definite,
+                        "{solver:?} shift {shift}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -48,7 +48,7 @@ mod updated_lagrangian;
 pub use line::{LineElement, LineMesh, MAX_LINE_NODES};
 pub use plane::{PlaneFem, PlaneFemSettings, PlaneLoads};
 pub use quad::{PlaneMesh, QuadElement, MAX_QUAD_NODES};
-pub use updated_lagrangian::{validate_stepping, GaussPoints, MAX_LOAD_STEPS};
+pub use updated_lagrangian::{validate_stepping, FemMesh, GaussPoints, MAX_LOAD_STEPS};
 
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
@@ -57,7 +57,7 @@ use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::problems::column::{ColumnOutcome, ColumnSpec, PointRecord};
 use crate::quadrature::GaussRule;
 use nalgebra::SVector;
-use updated_lagrangian::{FullLoads, UlCore};
+use updated_lagrangian::{fem_step, fem_step_system, UlCore};
 
 /// Settings of a [`LineFem`] analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -162,12 +162,8 @@ impl LineFem {
     /// Fill the support table: for each Gauss point its element's nodes, N_a(ξ_q) and
     /// ∂N_a/∂X̃ = (dX̃/dξ)⁻¹ dN_a/dξ on the current mesh (eqs 33–34).
     pub fn build_supports(&mut self) -> Result<(), StepFailure> {
-        line_supports(
-            &self.mesh,
-            &self.gauss.element,
-            &self.gauss.xi,
-            &mut self.core.work.table,
-        )
+        self.mesh
+            .fill_supports(&self.gauss.element, &self.gauss.xi, &mut self.core.work.table)
     }
 
     /// Supports of the last [`Self::build_supports`].
@@ -183,14 +179,16 @@ impl LineFem {
         load_factor: f64,
         f: impl FnOnce(&mut LoadStepSystem<'_, 1>) -> R,
     ) -> Result<R, StepFailure> {
-        self.build_supports()?;
-        let loads = line_loads(&self.loads, &self.gauss.mass);
-        let n = self.mesh.num_nodes();
-        Ok(self
-            .core
-            .with_input(&self.gauss.state, n, &loads, load_factor, |work, input| {
-                work.with_system(input, f)
-            }))
+        let gravity = SVector::<f64, 1>::new(self.loads.gravity);
+        fem_step_system(
+            &mut self.core,
+            &self.mesh,
+            &self.gauss,
+            gravity,
+            &self.loads.nodal_forces,
+            load_factor,
+            f,
+        )
     }
 
     /// Current position x(ξ_q) and Jacobian dx/dξ of Gauss point `p` on the current mesh.
@@ -206,61 +204,17 @@ impl LineFem {
     }
 }
 
-/// The loads of a line mesh: in 1D a node's dof is the node.
-fn line_loads<'a>(loads: &'a LineLoads, mass: &'a [f64]) -> FullLoads<'a, 1> {
-    FullLoads {
-        gravity: SVector::<f64, 1>::new(loads.gravity),
-        mass,
-        dof_forces: &loads.nodal_forces,
-    }
-}
-
-/// Line-element supports on the current mesh (see [`LineFem::build_supports`]).
-fn line_supports(
-    mesh: &LineMesh,
-    elements: &[usize],
-    xis: &[f64],
-    table: &mut SupportTable<1>,
-) -> Result<(), StepFailure> {
-    let element = mesh.element;
-    let k = element.nodes_per_element();
-    table.clear();
-    for (p, (&e, &xi)) in elements.iter().zip(xis).enumerate() {
-        let x = mesh.element_coordinates(e);
-        let (n, dn) = element.shape(xi);
-        let (_, jac) = element.map(&x[..k], xi);
-        if !(jac > 0.0 && jac.is_finite()) {
-            return Err(StepFailure::Kinematics {
-                point: p,
-                reason: format!("element {e} has dX/dξ = {jac:e} <= 0 at its Gauss point"),
-            });
-        }
-        let first = mesh.first_node(e);
-        for a in 0..k {
-            table.push_node(first + a, n[a], SVector::<f64, 1>::new(dn[a] / jac));
-        }
-        table.finish_point();
-    }
-    Ok(())
-}
-
 impl LoadStepping for LineFem {
     fn step(&mut self) -> Result<StepReport, SolveError> {
-        let loads = line_loads(&self.loads, &self.gauss.mass);
-        let (mesh, states) = (&self.mesh, &mut self.gauss.state);
-        let (elements, xis) = (&self.gauss.element, &self.gauss.xi);
-        let report = self.core.step(
+        fem_step(
+            &mut self.core,
+            &mut self.mesh,
+            &mut self.gauss,
+            SVector::<f64, 1>::new(self.loads.gravity),
+            &self.loads.nodal_forces,
             &self.settings.newton,
             self.settings.load_steps,
-            states,
-            mesh.num_nodes(),
-            &loads,
-            |table| line_supports(mesh, elements, xis, table),
-        )?;
-        // Updated Lagrangian: the converged configuration is the next reference.
-        let du = &self.core.work.du_nodal;
-        self.mesh.nodes.iter_mut().zip(du).for_each(|(x, d)| *x += d);
-        Ok(report)
+        )
     }
     fn steps_done(&self) -> usize {
         self.core.step

@@ -3,7 +3,7 @@
 //! and 3×3). Plane strain comes from the shared kinematics, which keep F₃₃ = 1.
 
 use super::quad::{PlaneMesh, QuadElement};
-use super::updated_lagrangian::{validate_stepping, FullLoads, GaussPoints, UlCore};
+use super::updated_lagrangian::{fem_step, fem_step_system, validate_stepping, FemMesh, GaussPoints, UlCore};
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_finite, InputError, SolveError, StepFailure};
@@ -157,12 +157,8 @@ impl PlaneFem {
     /// Fill the support table: for each Gauss point its element's nodes, N_a(ξ_q) and
     /// ∂N_a/∂X̃ = J⁻ᵀ ∂N_a/∂ξ on the current mesh (eqs 33–34).
     pub fn build_supports(&mut self) -> Result<(), StepFailure> {
-        plane_supports(
-            &self.mesh,
-            &self.gauss.element,
-            &self.gauss.xi,
-            &mut self.core.work.table,
-        )
+        self.mesh
+            .fill_supports(&self.gauss.element, &self.gauss.xi, &mut self.core.work.table)
     }
 
     /// Supports of the last [`Self::build_supports`].
@@ -177,14 +173,15 @@ impl PlaneFem {
         load_factor: f64,
         f: impl FnOnce(&mut LoadStepSystem<'_, 2>) -> R,
     ) -> Result<R, StepFailure> {
-        self.build_supports()?;
-        let loads = full_loads(&self.loads, &self.gauss.mass, &self.dof_forces);
-        let n = self.mesh.num_nodes();
-        Ok(self
-            .core
-            .with_input(&self.gauss.state, n, &loads, load_factor, |work, input| {
-                work.with_system(input, f)
-            }))
+        fem_step_system(
+            &mut self.core,
+            &self.mesh,
+            &self.gauss,
+            self.loads.gravity,
+            &self.dof_forces,
+            load_factor,
+            f,
+        )
     }
 
     /// Displacement of node `n` since the start of the analysis.
@@ -218,64 +215,17 @@ impl PlaneFem {
     }
 }
 
-fn full_loads<'a>(loads: &PlaneLoads, mass: &'a [f64], dof_forces: &'a [(usize, f64)]) -> FullLoads<'a, 2> {
-    FullLoads {
-        gravity: loads.gravity,
-        mass,
-        dof_forces,
-    }
-}
-
-/// Quadrilateral supports on the current mesh (see [`PlaneFem::build_supports`]).
-fn plane_supports(
-    mesh: &PlaneMesh,
-    elements: &[usize],
-    xis: &[V2],
-    table: &mut SupportTable<2>,
-) -> Result<(), StepFailure> {
-    let k = mesh.element.nodes_per_element();
-    table.clear();
-    for (p, (&e, xi)) in elements.iter().zip(xis).enumerate() {
-        let x = mesh.element_coordinates(e);
-        let (_, jac, n, dn) = mesh.element.map(&x, xi);
-        let det = jac.determinant();
-        let inv_t = match jac.try_inverse() {
-            Some(inv) if det > 0.0 && det.is_finite() => inv.transpose(),
-            _ => {
-                return Err(StepFailure::Kinematics {
-                    point: p,
-                    reason: format!("element {e} has det(∂x/∂ξ) = {det:e} <= 0 at a Gauss point"),
-                })
-            }
-        };
-        let nodes = mesh.element_nodes(e);
-        for a in 0..k {
-            table.push_node(nodes[a], n[a], inv_t * dn[a]);
-        }
-        table.finish_point();
-    }
-    Ok(())
-}
-
 impl LoadStepping for PlaneFem {
     fn step(&mut self) -> Result<StepReport, SolveError> {
-        let loads = full_loads(&self.loads, &self.gauss.mass, &self.dof_forces);
-        let (mesh, states) = (&self.mesh, &mut self.gauss.state);
-        let (elements, xis) = (&self.gauss.element, &self.gauss.xi);
-        let report = self.core.step(
+        fem_step(
+            &mut self.core,
+            &mut self.mesh,
+            &mut self.gauss,
+            self.loads.gravity,
+            &self.dof_forces,
             &self.settings.newton,
             self.settings.load_steps,
-            states,
-            mesh.num_nodes(),
-            &loads,
-            |table| plane_supports(mesh, elements, xis, table),
-        )?;
-        // Updated Lagrangian: the converged configuration is the next reference.
-        let du = &self.core.work.du_nodal;
-        for (n, x) in self.mesh.nodes.iter_mut().enumerate() {
-            *x += V2::new(du[2 * n], du[2 * n + 1]);
-        }
-        Ok(report)
+        )
     }
     fn steps_done(&self) -> usize {
         self.core.step

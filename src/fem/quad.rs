@@ -4,7 +4,9 @@
 //! corners 0–3 at (−1,−1), (1,−1), (1,1), (−1,1); for Q8 the mid-side nodes 4–7 at
 //! (0,−1), (1,0), (0,1), (−1,0). The maps are isoparametric, x(ξ) = Σ N_a(ξ) x_a.
 
-use crate::error::{require_count, InputError};
+use super::updated_lagrangian::FemMesh;
+use crate::assembly::SupportTable;
+use crate::error::{require_count, InputError, StepFailure};
 use crate::quadrature::GaussRule;
 use nalgebra::{Matrix2, SVector};
 use serde::{Deserialize, Serialize};
@@ -355,5 +357,50 @@ impl PlaneMesh {
                     .total_cmp(&(self.nodes[j] - x).norm_squared())
             })
             .expect("a mesh has nodes")
+    }
+}
+
+impl FemMesh<2> for PlaneMesh {
+    type Local = V2;
+
+    fn num_nodes(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// N_a(ξ_q) and ∂N_a/∂X̃ = J⁻ᵀ ∂N_a/∂ξ with J = ∂X̃/∂ξ on the current mesh (eqs 33–34).
+    fn fill_supports(
+        &self,
+        elements: &[usize],
+        xis: &[V2],
+        table: &mut SupportTable<2>,
+    ) -> Result<(), StepFailure> {
+        let k = self.element.nodes_per_element();
+        table.clear();
+        for (p, (&e, xi)) in elements.iter().zip(xis).enumerate() {
+            let x = self.element_coordinates(e);
+            let (_, jac, n, dn) = self.element.map(&x, xi);
+            let det = jac.determinant();
+            let inv_t = match jac.try_inverse() {
+                Some(inv) if det > 0.0 && det.is_finite() => inv.transpose(),
+                _ => {
+                    return Err(StepFailure::Kinematics {
+                        point: p,
+                        reason: format!("element {e} has det(∂x/∂ξ) = {det:e} <= 0 at a Gauss point"),
+                    })
+                }
+            };
+            let nodes = self.element_nodes(e);
+            for a in 0..k {
+                table.push_node(nodes[a], n[a], inv_t * dn[a]);
+            }
+            table.finish_point();
+        }
+        Ok(())
+    }
+
+    fn move_nodes(&mut self, du: &[f64]) {
+        for (n, x) in self.nodes.iter_mut().enumerate() {
+            *x += V2::new(du[2 * n], du[2 * n + 1]);
+        }
     }
 }

@@ -4,7 +4,7 @@
 //! positions). A solver adds only its shape functions: it fills the [`SupportTable`] with
 //! N_a(ξ_q) and ∂N_a/∂X̃ on the start-of-step mesh and moves its nodes by the increment.
 
-use crate::assembly::{StepInput, StepWorkspace, SupportTable};
+use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, InputError, SolveError, StepFailure};
 use crate::kinematics::PointState;
@@ -170,4 +170,82 @@ impl<const D: usize> UlCore<D> {
             newton: report,
         })
     }
+}
+
+/// A finite element mesh as the load-step machinery sees it: nodes that move with the material
+/// and shape functions evaluated at Gauss points on the current configuration.
+pub trait FemMesh<const D: usize> {
+    /// Local coordinate of a Gauss point in its element.
+    type Local;
+    fn num_nodes(&self) -> usize;
+    /// Fill `table` with, for each Gauss point (element `elements[p]`, local coordinate
+    /// `xis[p]`), its element's nodes, N_a(ξ_q) and ∂N_a/∂X̃ on the current mesh (eqs 33–34).
+    /// Fails if an element is inverted at a Gauss point.
+    fn fill_supports(
+        &self,
+        elements: &[usize],
+        xis: &[Self::Local],
+        table: &mut SupportTable<D>,
+    ) -> Result<(), StepFailure>;
+    /// Move the nodes by a nodal increment (dof = node·D + axis).
+    fn move_nodes(&mut self, du: &[f64]);
+}
+
+/// One load step of an updated-Lagrangian FEM solver on `mesh` (the shared body of
+/// `LoadStepping::step`): supports on the start-of-step mesh, Newton, commit of the Gauss
+/// point states, and the nodes moved by the converged increment, which makes the converged
+/// configuration the next reference.
+pub(crate) fn fem_step<const D: usize, M: FemMesh<D>>(
+    core: &mut UlCore<D>,
+    mesh: &mut M,
+    gauss: &mut GaussPoints<M::Local>,
+    gravity: SVector<f64, D>,
+    dof_forces: &[(usize, f64)],
+    newton: &NewtonSettings,
+    load_steps: usize,
+) -> Result<StepReport, SolveError> {
+    let loads = FullLoads {
+        gravity,
+        mass: &gauss.mass,
+        dof_forces,
+    };
+    let (elements, xis) = (&gauss.element, &gauss.xi);
+    let m: &M = mesh;
+    let report = core.step(
+        newton,
+        load_steps,
+        &mut gauss.state,
+        m.num_nodes(),
+        &loads,
+        |table| m.fill_supports(elements, xis, table),
+    )?;
+    mesh.move_nodes(&core.work.du_nodal);
+    Ok(report)
+}
+
+/// The nonlinear system of a load step at `load_factor` on the current mesh and committed
+/// states (supports, dof map, sparsity pattern, external force), handed to `f`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn fem_step_system<const D: usize, M: FemMesh<D>, R>(
+    core: &mut UlCore<D>,
+    mesh: &M,
+    gauss: &GaussPoints<M::Local>,
+    gravity: SVector<f64, D>,
+    dof_forces: &[(usize, f64)],
+    load_factor: f64,
+    f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
+) -> Result<R, StepFailure> {
+    mesh.fill_supports(&gauss.element, &gauss.xi, &mut core.work.table)?;
+    let loads = FullLoads {
+        gravity,
+        mass: &gauss.mass,
+        dof_forces,
+    };
+    Ok(core.with_input(
+        &gauss.state,
+        mesh.num_nodes(),
+        &loads,
+        load_factor,
+        |work, input| work.with_system(input, f),
+    ))
 }
