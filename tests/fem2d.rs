@@ -800,6 +800,12 @@ fn peak_memory_mib() -> f64 {
 /// tangent assembly and factorisation+solve of the first Newton iteration timed separately,
 /// for LU and LDLᵀ (`FEM2D_SCALING_SOLVERS`, default "ldlt,lu"). Sizes run in ascending
 /// order so the process peak after each is that size's peak.
+///
+/// Measured (2 shared cores, release): 64² LDLᵀ 0.20 s / 47 MiB, LU 0.37 s / 98 MiB;
+/// 256² (131,584 dofs) LDLᵀ 3.9 s / 643 MiB (numeric factorisation 0.42 s), LLᵀ 3.4 s /
+/// 643 MiB, LU 10.4 s / 1,286 MiB (numeric 2.56 s); 512² (525,312 dofs) LDLᵀ 19.4 s /
+/// 2,622 MiB (numeric 3.0 s). Each step took 3 Newton iterations. About 1.2 kB of the
+/// ~2.5 kB per Gauss point is the stored trial (`PointTrial<2>`, 1,168 bytes with D^alg).
 #[test]
 #[ignore]
 fn fem2d_scaling_one_elastic_step() {

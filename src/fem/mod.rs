@@ -1,7 +1,13 @@
-//! Updated-Lagrangian finite element comparators (§5.1, Table 1, Figure 11).
+//! Updated-Lagrangian finite element comparators (§5.1 Table 1 and Figure 11; §5.2 Figure 17;
+//! §5.3 Figure 21).
 //!
-//! The entry point is [`LineFem`], a 1D solver on a [`LineMesh`] of linear or quadratic
-//! elements with a Gauss rule of 1 to 5 points. It shares everything below the load-step loop
+//! The entry points are [`LineFem`], a 1D solver on a [`LineMesh`] of linear or quadratic
+//! elements with a Gauss rule of 1 to 5 points, and [`PlaneFem`], a plane-strain solver on a
+//! [`PlaneMesh`] of 4-node or 8-node serendipity quadrilaterals ([`QuadElement`]) with an n×n
+//! Gauss rule (default 2×2 for Q4, 3×3 for Q8). Both implement
+//! [`LoadStepping`] through the same generic load step
+//! (`fem_step` over the [`FemMesh`] trait: a mesh supplies its shape functions and moves its
+//! nodes; Gauss point storage is [`GaussPoints`]). Each shares everything below the load-step loop
 //! with the material point solver ([`crate::mpm::MpmSolver`]): Gauss points are integration
 //! points like material points, so each load step fills a [`SupportTable`] with the element
 //! shape functions N_a(ξ_q) and their gradients ∂N_a/∂X̃ on the start-of-step mesh

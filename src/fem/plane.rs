@@ -189,6 +189,11 @@ impl PlaneFem {
         self.mesh.nodes[n] - self.mesh0.nodes[n]
     }
 
+    /// Displacements of all nodes since the start of the analysis.
+    pub fn displacements(&self) -> Vec<V2> {
+        (0..self.mesh.num_nodes()).map(|n| self.displacement(n)).collect()
+    }
+
     /// Current position x(ξ_q) of Gauss point `p`.
     pub fn gauss_point_position(&self, p: usize) -> V2 {
         self.mesh.map(self.gauss.element[p], &self.gauss.xi[p]).0
