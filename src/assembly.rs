@@ -191,11 +191,20 @@ impl DofMap {
     }
 
     /// Sparsity pattern (per column, the rows) coupling every pair of free dofs that share a point.
+    ///
+    /// A point whose node list equals the previous point's adds nothing and is skipped: the
+    /// Gauss points of one element (and material points of one cell) come in runs, so this
+    /// divides the transient storage by the points per element on large meshes.
     pub fn pattern<const D: usize>(&self, table: &SupportTable<D>) -> Vec<Vec<usize>> {
         let mut columns: Vec<Vec<usize>> = vec![Vec::new(); self.count];
         let mut eqs = Vec::with_capacity(MAX_POINT_NODES * D);
+        let mut previous: &[usize] = &[];
         for p in 0..table.num_points() {
             let (nodes, _, _) = table.point(p);
+            if nodes == previous {
+                continue;
+            }
+            previous = nodes;
             eqs.clear();
             for &n in nodes {
                 for a in 0..D {
