@@ -337,7 +337,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         for p in 0..self.states.len() {
             let t = self.trials[p].as_ref().expect("evaluated");
             let m = self.spatial_gradients(p, t, &mut gx, &mut eqs);
-            let a = t.spatial_tangent();
+            let a = t.spatial_tangent(self.model, &self.states[p]);
             let v = t.volume;
             // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V.
             for kb in 0..m {

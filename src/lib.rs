@@ -27,7 +27,7 @@
 //! | F, ΔF | `PointState::f`, `PointTrial::delta_f` |
 //! | b^e, ε^e | `MaterialState::b_e`, `MaterialState::eps_e` |
 //! | τ, σ | `MaterialResponse::tau`, `PointTrial::sigma` |
-//! | D^alg, a_ijkl | `MaterialResponse::d_alg`, `PointTrial::tangent` |
+//! | D^alg, a_ijkl | `ConstitutiveModel::tangent`, `PointTrial::spatial_tangent` |
 //! | V_p, V_p^n | `PointTrial::volume`, `PointState::volume` |
 //! | l_p | `MaterialPoints::half_length` (half of l_p) |
 

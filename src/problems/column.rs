@@ -400,6 +400,7 @@ impl ColumnSpec {
             weak_node_tolerance: 0.0,
             weak_node_treatment: Default::default(),
             volume_update: Default::default(),
+            linear_solver: Default::default(),
         };
         MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, settings)
     }
