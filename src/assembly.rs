@@ -330,41 +330,102 @@ impl<const D: usize> LoadStepSystem<'_, D> {
 
     /// Assemble the tangent `K = Σ_p [G]ᵀ[a][G] V_p` (eq 27) at the trial states of the last
     /// [`Self::assemble_residual`].
+    ///
+    /// Points are processed in chunks: their local matrices are formed in parallel into a
+    /// buffer reused across chunks, then scattered in parallel by column blocks, each block
+    /// owned by one thread and filled in point order. Every entry thus receives its
+    /// contributions in the same order whatever the thread count.
     pub fn assemble_tangent(&mut self) {
+        const CHUNK: usize = 4096;
+        let stride_eq = MAX_POINT_NODES * D;
         self.matrix.clear_values();
-        let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
-        let mut eqs = [None; MAX_POINT_NODES * 3];
-        for p in 0..self.states.len() {
-            let t = self.trials[p].as_ref().expect("evaluated");
-            let m = self.spatial_gradients(p, t, &mut gx, &mut eqs);
-            let a = t.spatial_tangent(self.model, &self.states[p]);
-            let v = t.volume;
-            // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V.
-            for kb in 0..m {
-                for k in 0..D {
-                    let Some(col) = eqs[kb * D + k] else { continue };
-                    let mut c = [[0.0; 3]; 3];
-                    for i in 0..D {
-                        for j in 0..D {
-                            let mut s = 0.0;
-                            for l in 0..D {
-                                s += a[(ij(i, j), ij(k, l))] * gx[kb][l];
-                            }
-                            c[i][j] = s * v;
+        let n = self.states.len();
+        let (table, dofs, model, states, trials) =
+            (self.table, self.dofs, self.model, self.states, &*self.trials);
+        let mut local: Vec<f64> = Vec::new();
+        let mut eq_buf: Vec<Option<usize>> = Vec::new();
+        let mut sizes: Vec<usize> = Vec::new();
+        let threads = rayon::current_num_threads();
+        for start in (0..n).step_by(CHUNK) {
+            let end = (start + CHUNK).min(n);
+            let len = end - start;
+            let m_max = (start..end).map(|p| table.point(p).0.len()).max().unwrap_or(0);
+            let stride_k = (m_max * D) * (m_max * D);
+            local.clear();
+            local.resize(len * stride_k, 0.0);
+            eq_buf.clear();
+            eq_buf.resize(len * stride_eq, None);
+            sizes.clear();
+            sizes.resize(len, 0);
+            local
+                .par_chunks_mut(stride_k.max(1))
+                .zip(eq_buf.par_chunks_mut(stride_eq))
+                .zip(sizes.par_iter_mut())
+                .enumerate()
+                .for_each(|(i, ((kl, eqs), size))| {
+                    let p = start + i;
+                    let t = trials[p].as_ref().expect("evaluated");
+                    let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
+                    let (nodes, _, g) = table.point(p);
+                    let inv_t = t.delta_f_inv.transpose();
+                    for k in 0..nodes.len() {
+                        gx[k] = inv_t * g[k]; // eq (36)
+                        for a in 0..D {
+                            eqs[k * D + a] = dofs.eq(nodes[k] * D + a);
                         }
                     }
-                    for ka in 0..m {
-                        for i in 0..D {
-                            let Some(row) = eqs[ka * D + i] else { continue };
-                            let mut s = 0.0;
-                            for j in 0..D {
-                                s += gx[ka][j] * c[i][j];
+                    let md = nodes.len() * D;
+                    *size = md;
+                    let a = t.spatial_tangent(model, &states[p]);
+                    let v = t.volume;
+                    // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V.
+                    for kb in 0..nodes.len() {
+                        for k in 0..D {
+                            let mut c = [[0.0; 3]; 3];
+                            for i in 0..D {
+                                for j in 0..D {
+                                    let mut s = 0.0;
+                                    for l in 0..D {
+                                        s += a[(ij(i, j), ij(k, l))] * gx[kb][l];
+                                    }
+                                    c[i][j] = s * v;
+                                }
                             }
-                            self.matrix.add(row, col, s);
+                            for ka in 0..nodes.len() {
+                                for i in 0..D {
+                                    let mut s = 0.0;
+                                    for j in 0..D {
+                                        s += gx[ka][j] * c[i][j];
+                                    }
+                                    kl[(ka * D + i) * md + kb * D + k] = s;
+                                }
+                            }
                         }
                     }
-                }
-            }
+                });
+            let (local, eq_buf, sizes) = (&local, &eq_buf, &sizes);
+            self.matrix
+                .column_blocks(threads)
+                .into_par_iter()
+                .for_each(|mut block| {
+                    for i in 0..len {
+                        let md = sizes[i];
+                        let eqs = &eq_buf[i * stride_eq..i * stride_eq + md];
+                        let kl = &local[i * stride_k..];
+                        for (ci, col) in eqs.iter().enumerate() {
+                            let Some(col) = *col else { continue };
+                            if !block.owns(col) {
+                                continue;
+                            }
+                            let mut hint = usize::MAX;
+                            for (ri, row) in eqs.iter().enumerate() {
+                                if let Some(row) = *row {
+                                    block.add_with_hint(row, col, kl[ri * md + ci], &mut hint);
+                                }
+                            }
+                        }
+                    }
+                });
         }
     }
 }

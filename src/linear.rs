@@ -51,7 +51,84 @@ pub struct SparseSystem {
     fallbacks: usize,
 }
 
+/// A contiguous range of columns of a [`SparseSystem`] whose values one thread may update
+/// while other threads update other blocks.
+pub struct ColumnBlock<'a> {
+    first_col: usize,
+    end_col: usize,
+    col_ptr: &'a [usize],
+    row_idx: &'a [usize],
+    /// Values of columns `first_col..end_col`, starting at `col_ptr[first_col]`.
+    values: &'a mut [f64],
+}
+
+impl ColumnBlock<'_> {
+    /// Does this block own column `col`?
+    #[inline]
+    pub fn owns(&self, col: usize) -> bool {
+        col >= self.first_col && col < self.end_col
+    }
+    /// `K[row, col] += v` for an owned column, trying position `*hint` first and leaving
+    /// the next position in it: runs of consecutive rows (the dofs of neighbouring nodes)
+    /// then need one search per run instead of one per entry.
+    #[inline]
+    pub fn add_with_hint(&mut self, row: usize, col: usize, v: f64, hint: &mut usize) {
+        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        let k = if *hint >= a && *hint < b && self.row_idx[*hint] == row {
+            *hint
+        } else {
+            match self.row_idx[a..b].binary_search(&row) {
+                Ok(k) => a + k,
+                Err(_) => panic!("entry ({row}, {col}) is not in the sparsity pattern"),
+            }
+        };
+        self.values[k - self.col_ptr[self.first_col]] += v;
+        *hint = k + 1;
+    }
+
+    /// `K[row, col] += v` for an owned column.
+    #[inline]
+    pub fn add(&mut self, row: usize, col: usize, v: f64) {
+        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        match self.row_idx[a..b].binary_search(&row) {
+            Ok(k) => self.values[a + k - self.col_ptr[self.first_col]] += v,
+            Err(_) => panic!("entry ({row}, {col}) is not in the sparsity pattern"),
+        }
+    }
+}
+
 impl SparseSystem {
+    /// Split the columns into at most `parts` blocks of about equal numbers of entries, for
+    /// parallel assembly: each entry is then updated by exactly one thread.
+    pub fn column_blocks(&mut self, parts: usize) -> Vec<ColumnBlock<'_>> {
+        let parts = parts.max(1).min(self.n.max(1));
+        let nnz = self.row_idx.len();
+        let mut bounds = vec![0];
+        for k in 1..parts {
+            let target = nnz * k / parts;
+            let c = self.col_ptr.partition_point(|&p| p < target).min(self.n);
+            if c > *bounds.last().unwrap() {
+                bounds.push(c);
+            }
+        }
+        bounds.push(self.n);
+        let mut blocks = Vec::with_capacity(bounds.len() - 1);
+        let mut rest: &mut [f64] = &mut self.values;
+        for w in bounds.windows(2) {
+            let len = self.col_ptr[w[1]] - self.col_ptr[w[0]];
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            rest = tail;
+            blocks.push(ColumnBlock {
+                first_col: w[0],
+                end_col: w[1],
+                col_ptr: &self.col_ptr,
+                row_idx: &self.row_idx,
+                values: head,
+            });
+        }
+        blocks
+    }
+
     /// Build the pattern from `columns[c]` = rows that may be non-zero in column `c`
     /// (unsorted, duplicates allowed). Resets the cached symbolic factorisation.
     pub fn set_pattern(&mut self, mut columns: Vec<Vec<usize>>) {
