@@ -256,10 +256,22 @@ pub trait LoadStepping {
     /// Run all remaining load steps. On failure returns the reports of the converged steps
     /// and the error; the solver then holds the last converged state.
     fn run(&mut self) -> Result<Vec<StepReport>, (Vec<StepReport>, SolveError)> {
+        self.run_observed(&mut |_, _| {})
+    }
+
+    /// [`Self::run`], calling `after_step` with the solver and the report after each
+    /// converged step (e.g. to write the state for ParaView).
+    fn run_observed(
+        &mut self,
+        after_step: &mut dyn FnMut(&Self, &StepReport),
+    ) -> Result<Vec<StepReport>, (Vec<StepReport>, SolveError)> {
         let mut reports = Vec::with_capacity(self.load_steps());
         while self.steps_done() < self.load_steps() {
             match self.step() {
-                Ok(r) => reports.push(r),
+                Ok(r) => {
+                    after_step(self, &r);
+                    reports.push(r)
+                }
                 Err(e) => return Err((reports, e)),
             }
         }

@@ -11,6 +11,8 @@
 
 pub mod rates;
 pub mod runner;
+pub mod store;
+pub mod vtk_output;
 
 use crate::newton::NewtonSettings;
 use crate::problems::column::{ColumnSpec, Method};
