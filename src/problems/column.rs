@@ -333,7 +333,7 @@ impl ColumnSpec {
                 "must be <= 64",
             ));
         }
-        require_count("load_steps", self.load_steps, 1)?;
+        crate::fem::validate_stepping(&self.newton, self.load_steps)?;
         self.newton.validate()?;
         self.model()?;
         if let Some(n) = self.gauss_points {
