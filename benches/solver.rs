@@ -1,19 +1,61 @@
-//! Speed of the solver core: one load step of the W = 400,000 column (2 points per element)
-//! at 256 and 512 elements, and the per-point kinematics + constitutive + tangent kernel.
+//! Speed of the solver core, sizes from `benches/sizes.toml`:
+//! - `column_load_step`: one load step of the W = 400,000 column (2 points per element);
+//! - `weights`: MPM and GIMP weights and gradients of many points (1D, 2D);
+//! - `point_kernel`: kinematics + constitutive update + spatial tangent of one point, linear
+//!   elastic and von Mises (plastic return);
+//! - `assembly`: residual and tangent of a plane-strain Q4 mesh;
+//! - `factorisation`: numeric LU / LDLᵀ / LLᵀ + solve of that tangent.
+//!
 //! `cargo bench --bench solver`
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
-use igimp::basis::Basis;
-use igimp::constitutive::LinearElastic;
+use igimp::basis::{Basis, Support};
+use igimp::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
+use igimp::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
+use igimp::grid::Grid;
 use igimp::kinematics::{evaluate_point, PointState};
-use igimp::newton::LoadStepping;
+use igimp::linear::LinearSolver;
+use igimp::newton::{LoadStepping, NonlinearSystem};
 use igimp::problems::column::ColumnSpec;
-use nalgebra::SMatrix;
+use nalgebra::{SMatrix, SVector};
+use serde::Deserialize;
 use std::hint::black_box;
+
+#[derive(Deserialize)]
+struct Sizes {
+    load_step: LoadStepSizes,
+    weights: WeightSizes,
+    assembly: MeshSizes,
+    factorisation: FactorSizes,
+}
+#[derive(Deserialize)]
+struct LoadStepSizes {
+    column_elements: Vec<usize>,
+}
+#[derive(Deserialize)]
+struct WeightSizes {
+    points: usize,
+    cells: usize,
+}
+#[derive(Deserialize)]
+struct MeshSizes {
+    q4_cells: Vec<[usize; 2]>,
+}
+#[derive(Deserialize)]
+struct FactorSizes {
+    q4_cells: Vec<[usize; 2]>,
+    solvers: Vec<LinearSolver>,
+}
+
+fn sizes() -> Sizes {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/sizes.toml");
+    let text = std::fs::read_to_string(path).expect("benches/sizes.toml");
+    toml::from_str(&text).expect("benches/sizes.toml: invalid")
+}
 
 fn load_step(c: &mut Criterion) {
     let mut group = c.benchmark_group("column_load_step");
-    for elements in [256usize, 512] {
+    for elements in sizes().load_step.column_elements {
         let spec = ColumnSpec {
             elements,
             weight: 400_000.0,
@@ -37,34 +79,141 @@ fn load_step(c: &mut Criterion) {
     group.finish();
 }
 
+/// Weights of `n` points spread over the grid (deterministic quasi-random positions).
+fn weights_of<const D: usize>(c: &mut Criterion, n: usize, cells: usize) {
+    let h = 1.0 / cells as f64;
+    let grid = Grid::<D>::try_new([0.0; D], [h; D], [cells; D]).unwrap();
+    let half = SVector::<f64, D>::repeat(0.25 * h);
+    let points: Vec<SVector<f64, D>> = (0..n)
+        .map(|p| {
+            SVector::<f64, D>::from_fn(|a, _| {
+                let t = ((p * (a + 1)) as f64 * 0.618_033_988_75).fract();
+                h + t * (1.0 - 2.0 * h)
+            })
+        })
+        .collect();
+    let mut group = c.benchmark_group("weights");
+    for basis in [Basis::Mpm, Basis::Gimp] {
+        let mut sup = Support::<D>::default();
+        group.bench_function(format!("{basis:?}_{D}d_{n}_points"), |b| {
+            b.iter(|| {
+                for x in &points {
+                    basis.evaluate(&grid, x, &half, &mut sup).unwrap();
+                    black_box(&sup);
+                }
+            })
+        });
+    }
+    group.finish();
+}
+
+fn weights(c: &mut Criterion) {
+    let s = sizes().weights;
+    weights_of::<1>(c, s.points, s.cells);
+    weights_of::<2>(c, s.points, s.cells);
+}
+
 fn point_kernel(c: &mut Criterion) {
-    let model = LinearElastic::try_new(1e6, 0.3).unwrap();
+    let elastic = LinearElastic::try_new(1e6, 0.3).unwrap();
+    // Yield stress below the trial stress of `g2`: the von Mises case takes the return map.
+    let plastic = VonMises::try_new(1e6, 0.3, 1e3).unwrap();
     let state = PointState::undeformed(0.1);
     let g1 = SMatrix::<f64, 1, 1>::new(-0.05);
     let g2 = SMatrix::<f64, 2, 2>::new(-0.05, 0.02, 0.01, 0.03);
-    c.bench_function("point_kernel_1d_with_tangent", |b| {
-        b.iter(|| {
-            black_box(
-                evaluate_point::<1>(&model, &state, black_box(&g1))
-                    .unwrap()
-                    .spatial_tangent(&model, &state),
-            )
+    let models: [(&str, &dyn ConstitutiveModel); 2] = [("elastic", &elastic), ("von_mises", &plastic)];
+    let mut group = c.benchmark_group("point_kernel");
+    for (name, model) in models {
+        group.bench_function(format!("{name}_1d_with_tangent"), |b| {
+            b.iter(|| {
+                black_box(
+                    evaluate_point::<1>(model, &state, black_box(&g1))
+                        .unwrap()
+                        .spatial_tangent(model, &state),
+                )
+            })
+        });
+        group.bench_function(format!("{name}_2d_with_tangent"), |b| {
+            b.iter(|| {
+                black_box(
+                    evaluate_point::<2>(model, &state, black_box(&g2))
+                        .unwrap()
+                        .spatial_tangent(model, &state),
+                )
+            })
+        });
+    }
+    group.finish();
+}
+
+/// A unit-weight elastic block of Q4 elements, fixed at its base.
+fn q4_block(cells: [usize; 2], solver: LinearSolver) -> PlaneFem {
+    let size = SVector::<f64, 2>::new(cells[0] as f64, cells[1] as f64);
+    let mesh = PlaneMesh::rectangle(SVector::zeros(), size, (cells[0], cells[1]), QuadElement::Q4).unwrap();
+    let fixed = mesh
+        .nodes_at(1, 0.0, 1e-9)
+        .into_iter()
+        .flat_map(|n| [(n, 0), (n, 1)])
+        .collect();
+    let loads = PlaneLoads {
+        gravity: SVector::<f64, 2>::new(0.0, -10.0),
+        nodal_forces: vec![],
+    };
+    let settings = PlaneFemSettings {
+        linear_solver: solver,
+        ..PlaneFemSettings::default()
+    };
+    let model = Box::new(LinearElastic::try_new(1e6, 0.3).unwrap());
+    PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings).unwrap()
+}
+
+fn assembly(c: &mut Criterion) {
+    let mut group = c.benchmark_group("assembly");
+    for cells in sizes().assembly.q4_cells {
+        let mut fem = q4_block(cells, LinearSolver::Lu);
+        let label = format!("q4_{}x{}", cells[0], cells[1]);
+        fem.with_step_system(1.0, |sys| {
+            let n = sys.num_unknowns();
+            let u = vec![1e-4; n];
+            let mut r = vec![0.0; n];
+            group.bench_function(format!("residual_{label}"), |b| {
+                b.iter(|| sys.evaluate(black_box(&u), &mut r).unwrap())
+            });
+            group.bench_function(format!("tangent_{label}"), |b| b.iter(|| sys.assemble_tangent()));
         })
-    });
-    c.bench_function("point_kernel_2d_with_tangent", |b| {
-        b.iter(|| {
-            black_box(
-                evaluate_point::<2>(&model, &state, black_box(&g2))
-                    .unwrap()
-                    .spatial_tangent(&model, &state),
-            )
-        })
-    });
+        .unwrap();
+    }
+    group.finish();
+}
+
+fn factorisation(c: &mut Criterion) {
+    let s = sizes().factorisation;
+    let mut group = c.benchmark_group("factorisation");
+    for cells in s.q4_cells {
+        for &solver in &s.solvers {
+            let mut fem = q4_block(cells, solver);
+            fem.with_step_system(1.0, |sys| {
+                let n = sys.num_unknowns();
+                let mut r = vec![0.0; n];
+                sys.evaluate(&vec![0.0; n], &mut r).unwrap();
+                sys.assemble_tangent();
+                let label = format!("{solver:?}_q4_{}x{}_{n}_unknowns", cells[0], cells[1]).to_lowercase();
+                group.bench_function(label, |b| {
+                    b.iter(|| {
+                        let mut rhs = r.clone();
+                        sys.matrix.solve_in_place(&mut rhs).unwrap();
+                        black_box(rhs)
+                    })
+                });
+            })
+            .unwrap();
+        }
+    }
+    group.finish();
 }
 
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = load_step, point_kernel
+    targets = load_step, weights, point_kernel, assembly, factorisation
 }
 criterion_main!(benches);

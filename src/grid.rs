@@ -6,6 +6,9 @@
 use crate::error::{require_count, require_finite, require_positive, InputError};
 use nalgebra::SVector;
 
+/// Most nodes a grid may have (checked before anything per node is allocated).
+pub const MAX_GRID_NODES: usize = 20_000_000;
+
 /// Axis-aligned regular grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Grid<const D: usize> {
@@ -31,6 +34,15 @@ impl<const D: usize> Grid<D> {
                     "must be <= 50000000",
                 ));
             }
+        }
+        // Nodal vectors (D values per node) are allocated every load step.
+        let nodes = cells.iter().try_fold(1usize, |n, &c| n.checked_mul(c + 1));
+        if nodes.is_none_or(|n| n > MAX_GRID_NODES) {
+            return Err(InputError::new(
+                "grid.cells",
+                format!("{cells:?}"),
+                format!("the grid must have at most {MAX_GRID_NODES} nodes"),
+            ));
         }
         Ok(Self {
             origin,

@@ -53,3 +53,4 @@ pub mod quadrature;
 pub mod report;
 pub mod study;
 pub mod tensor;
+pub mod vtk;

@@ -214,6 +214,13 @@ impl<const D: usize> MpmSolver<D> {
         Ok(())
     }
 
+    /// Nodal displacement increment Δu of the last converged load step (node-major:
+    /// `node * D + axis`; empty before the first step). The grid is reset every step, so this
+    /// is the only nodal displacement the solver has.
+    pub fn step_increment(&self) -> &[f64] {
+        &self.work.du_nodal
+    }
+
     /// Supports of the last [`Self::build_supports`].
     pub fn supports(&self) -> &SupportTable<D> {
         &self.work.table

@@ -3,6 +3,10 @@
 use crate::error::{require_count, require_positive, InputError, SolveError, StepFailure};
 use serde::{Deserialize, Serialize};
 
+/// Upper bound of [`NewtonSettings::max_iterations`]: far beyond any useful Newton run, and
+/// small enough that the residual history can be allocated up front.
+pub const MAX_NEWTON_ITERATIONS: usize = 100_000;
+
 /// Newton settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -39,7 +43,15 @@ impl NewtonSettings {
                 "must lie in (0, 1)",
             ));
         }
-        require_count("newton.max_iterations", self.max_iterations, 1)
+        require_count("newton.max_iterations", self.max_iterations, 1)?;
+        if self.max_iterations > MAX_NEWTON_ITERATIONS {
+            return Err(InputError::new(
+                "newton.max_iterations",
+                self.max_iterations,
+                format!("must be <= {MAX_NEWTON_ITERATIONS}"),
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -85,7 +97,7 @@ pub fn solve(
 ) -> Result<NewtonReport, (StepFailure, Vec<f64>)> {
     let n = system.num_unknowns();
     let mut r = vec![0.0; n];
-    let mut history = Vec::with_capacity(settings.max_iterations + 1);
+    let mut history = Vec::with_capacity(settings.max_iterations.min(64) + 1);
     let scale = system.reference_norm();
     let scale = if scale > 0.0 && scale.is_finite() {
         scale
@@ -256,10 +268,22 @@ pub trait LoadStepping {
     /// Run all remaining load steps. On failure returns the reports of the converged steps
     /// and the error; the solver then holds the last converged state.
     fn run(&mut self) -> Result<Vec<StepReport>, (Vec<StepReport>, SolveError)> {
-        let mut reports = Vec::with_capacity(self.load_steps());
+        self.run_observed(&mut |_, _| {})
+    }
+
+    /// [`Self::run`], calling `after_step` with the solver and the report after each
+    /// converged step (e.g. to write the state for ParaView).
+    fn run_observed(
+        &mut self,
+        after_step: &mut dyn FnMut(&Self, &StepReport),
+    ) -> Result<Vec<StepReport>, (Vec<StepReport>, SolveError)> {
+        let mut reports = Vec::with_capacity(self.load_steps().min(1024));
         while self.steps_done() < self.load_steps() {
             match self.step() {
-                Ok(r) => reports.push(r),
+                Ok(r) => {
+                    after_step(self, &r);
+                    reports.push(r)
+                }
                 Err(e) => return Err((reports, e)),
             }
         }

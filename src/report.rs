@@ -597,15 +597,22 @@ pub fn render_index(out: &Path) -> Result<PathBuf, StudyError> {
             }
         );
         let _ = writeln!(s, "- [tables]({name}/{})", results.study.report_file);
-        for f in &results.study.figures {
-            let _ = writeln!(s, "- [{}]({name}/{}.svg)", f.title, f.id);
-        }
         let _ = writeln!(
             s,
-            "- [results.json]({name}/results.json) and per-case point files in `{name}/points/`\n"
+            "- [results.json]({name}/results.json) and per-case point files in `{name}/points/`"
         );
+        if d.join("vtk").is_dir() {
+            let _ = writeln!(
+                s,
+                "- ParaView files (`study {name} --vtk`): `{name}/vtk/<case>.pvd`"
+            );
+        }
+        s.push('\n');
+        for f in &results.study.figures {
+            let _ = writeln!(s, "### {}\n\n![{}]({name}/{}.svg)\n", f.title, f.title, f.id);
+        }
     }
     let p = out.join("index.md");
-    std::fs::write(&p, s).map_err(|e| StudyError::io(&p, e))?;
+    crate::study::store::write_file(&p, s.as_bytes())?;
     Ok(p)
 }

@@ -6,7 +6,10 @@
 
 use clap::{CommandFactory, FromArgMatches, Parser};
 use igimp::report;
-use igimp::study::runner::{read_results, run_study, study_dir, write_outputs, CaseRecord, CaseStatus};
+use igimp::study::runner::{
+    read_results, run_study_in, study_dir, write_outputs, CaseRecord, CaseStatus, RunOptions,
+};
+use igimp::study::vtk_output::VtkOptions;
 use igimp::study::{study_files, StudyError, StudySpec, Tier};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -41,6 +44,17 @@ struct Cli {
     /// Exit with status 2 if an expected rate or comparison fails or could not be evaluated.
     #[arg(long)]
     check: bool,
+    /// Reuse the cases an earlier (e.g. interrupted) run finished with the same inputs
+    /// (`<out>/<name>/cases/`, keyed by a hash of each case's definition); solve the rest.
+    #[arg(long)]
+    resume: bool,
+    /// Write ParaView files: `<out>/<name>/vtk/<case>.pvd` with the material/Gauss points and
+    /// the grid/mesh of the initial and the final state.
+    #[arg(long)]
+    vtk: bool,
+    /// With --vtk, also write every N-th load step (implies --vtk).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    vtk_every: Option<u32>,
 }
 
 /// `studies/` in the working directory, else the one in the source tree.
@@ -75,6 +89,8 @@ fn studies_help(dir: &Path) -> String {
     s.push_str(
         "\nExamples:\n  study column            full column study into reports/column/\n  \
          study column --quick    the CI tier\n  study all --render-only redraw every report from results.json\n  \
+         study column --resume   finish an interrupted run, reusing its finished cases\n  \
+         study column --quick --vtk  ParaView files into reports/column/vtk/\n  \
          study list              list the studies",
     );
     s
@@ -122,8 +138,25 @@ fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
             || file.display().to_string(),
             |f| f.to_string_lossy().into_owned(),
         );
-        let run = run_study(&spec, &file_name, tier, &on_done);
+        let options = RunOptions {
+            out: cli.out.clone(),
+            resume: cli.resume,
+            vtk: (cli.vtk || cli.vtk_every.is_some()).then(|| VtkOptions {
+                every: cli.vtk_every.map_or(0, |n| n as usize),
+            }),
+        };
+        let run = run_study_in(&spec, &file_name, tier, &options, &on_done);
         bar.finish_and_clear();
+        let run = run?;
+        if cli.resume {
+            eprintln!(
+                "{}: resumed {} of {} cases from {}",
+                spec.name,
+                run.resumed,
+                run.results.cases.len(),
+                dir.join("cases").display()
+            );
+        }
         write_outputs(&cli.out, &run)?;
         let r = &run.results;
         let failed = r.cases.iter().filter(|c| c.status == CaseStatus::Failed).count();

@@ -60,7 +60,7 @@ use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_finite, InputError, SolveError, StepFailure};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
-use crate::problems::column::{ColumnOutcome, ColumnSpec, PointRecord};
+use crate::problems::column::{ColumnObserver, ColumnOutcome, ColumnSpec, ColumnState, PointRecord};
 use crate::quadrature::GaussRule;
 use nalgebra::SVector;
 use updated_lagrangian::{fem_step, fem_step_system, UlCore};
@@ -255,8 +255,19 @@ impl ColumnSpec {
 /// base F that of the bottom-most Gauss point (eq 47), through the same
 /// [`ColumnOutcome::from_records`] as the material point methods.
 pub fn solve_column(spec: &ColumnSpec, element: LineElement) -> Result<ColumnOutcome, InputError> {
+    solve_column_observed(spec, element, &mut |_, _| {})
+}
+
+/// [`solve_column`] showing the solver to `observer` before the first and after every
+/// converged load step.
+pub fn solve_column_observed(
+    spec: &ColumnSpec,
+    element: LineElement,
+    observer: &mut ColumnObserver<'_>,
+) -> Result<ColumnOutcome, InputError> {
     let mut solver = spec.fem_solver(element)?;
-    let (steps, failure) = match solver.run() {
+    observer(0, ColumnState::Fem(&solver));
+    let (steps, failure) = match solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Fem(s))) {
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
     };

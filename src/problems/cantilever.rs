@@ -81,7 +81,7 @@ impl CantileverSpec {
         require_positive("grid_below", self.grid_below)?;
         require_positive("grid_margin", self.grid_margin)?;
         crate::error::require_finite("load", self.load)?;
-        require_count("load_steps", self.load_steps, 1)?;
+        crate::fem::validate_stepping(&self.newton, self.load_steps)?;
         require_count("points_per_cell", self.points_per_cell, 1)?;
         if self.points_per_cell > 16 {
             return Err(InputError::new(

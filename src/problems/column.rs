@@ -333,7 +333,7 @@ impl ColumnSpec {
                 "must be <= 64",
             ));
         }
-        require_count("load_steps", self.load_steps, 1)?;
+        crate::fem::validate_stepping(&self.newton, self.load_steps)?;
         self.newton.validate()?;
         self.model()?;
         if let Some(n) = self.gauss_points {
@@ -508,20 +508,51 @@ impl ColumnOutcome {
     }
 }
 
+/// The solver of a column case between load steps, handed to a [`ColumnObserver`].
+#[derive(Clone, Copy)]
+pub enum ColumnState<'a> {
+    Mpm(&'a MpmSolver<1>),
+    Fem(&'a crate::fem::LineFem),
+}
+
+/// Called with the load step number (0 before the first step) and the solver after the
+/// initial state and after every converged step, e.g. to write VTK files.
+pub type ColumnObserver<'a> = dyn FnMut(usize, ColumnState<'_>) + 'a;
+
 /// Run the column with any method.
 pub fn solve_column(spec: &ColumnSpec, method: Method) -> Result<ColumnOutcome, InputError> {
+    solve_column_observed(spec, method, &mut |_, _| {})
+}
+
+/// [`solve_column`], showing the solver to `observer` before the first and after every
+/// converged load step.
+pub fn solve_column_observed(
+    spec: &ColumnSpec,
+    method: Method,
+    observer: &mut ColumnObserver<'_>,
+) -> Result<ColumnOutcome, InputError> {
+    use crate::fem::LineElement;
     match method {
-        Method::Mpm => solve_mpm(spec, Basis::Mpm),
-        Method::Igimp => solve_mpm(spec, Basis::Gimp),
-        Method::FemLinear => crate::fem::solve_column(spec, crate::fem::LineElement::Linear),
-        Method::FemQuadratic => crate::fem::solve_column(spec, crate::fem::LineElement::Quadratic),
+        Method::Mpm => solve_mpm_observed(spec, Basis::Mpm, observer),
+        Method::Igimp => solve_mpm_observed(spec, Basis::Gimp, observer),
+        Method::FemLinear => crate::fem::solve_column_observed(spec, LineElement::Linear, observer),
+        Method::FemQuadratic => crate::fem::solve_column_observed(spec, LineElement::Quadratic, observer),
     }
 }
 
 /// Run the column with MPM or GIMP weights.
 pub fn solve_mpm(spec: &ColumnSpec, basis: Basis) -> Result<ColumnOutcome, InputError> {
+    solve_mpm_observed(spec, basis, &mut |_, _| {})
+}
+
+fn solve_mpm_observed(
+    spec: &ColumnSpec,
+    basis: Basis,
+    observer: &mut ColumnObserver<'_>,
+) -> Result<ColumnOutcome, InputError> {
     let mut solver = spec.mpm_solver(basis)?;
-    let (steps, failure) = match solver.run() {
+    observer(0, ColumnState::Mpm(&solver));
+    let (steps, failure) = match solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Mpm(s))) {
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
     };

@@ -88,7 +88,7 @@ impl CompactionSpec {
                 "must be <= 16",
             ));
         }
-        require_count("load_steps", self.load_steps, 1)?;
+        crate::fem::validate_stepping(&self.newton, self.load_steps)?;
         self.newton.validate()?;
         for a in 0..2 {
             require_positive(&format!("grid_extent[{a}]"), self.grid_extent[a])?;

@@ -11,6 +11,8 @@
 
 pub mod rates;
 pub mod runner;
+pub mod store;
+pub mod vtk_output;
 
 use crate::newton::NewtonSettings;
 use crate::problems::column::{ColumnSpec, Method};
@@ -348,6 +350,15 @@ pub fn weight_label(w: f64) -> String {
     }
 }
 
+/// A float as written in an error: scientific notation when very large or small.
+fn short(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e15).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
+}
+
 struct Checker<'a> {
     file: &'a str,
 }
@@ -372,7 +383,7 @@ impl Checker<'_> {
         if v.is_finite() && v > 0.0 {
             Ok(())
         } else {
-            Err(self.err(key, v, "must be finite and > 0"))
+            Err(self.err(key, short(v), "must be finite and > 0"))
         }
     }
     fn ident(&self, key: &str, v: &str) -> Result<(), StudyError> {
@@ -405,6 +416,11 @@ impl Checker<'_> {
 }
 
 const MAX_ELEMENTS: i64 = 1_000_000;
+/// Most material points of one case (elements × points per cell): ~0.6 GB of point state.
+const MAX_POINTS_PER_CASE: i64 = 2_000_000;
+/// Most cases of one sweep (methods × weights × points per cell × elements), checked before
+/// the case list is built.
+const MAX_CASES_PER_SWEEP: usize = 10_000;
 const MAX_POINTS_PER_CELL: i64 = 64;
 
 impl StudySpec {
@@ -601,7 +617,7 @@ impl StudySpec {
             if w > limit {
                 return Err(c.err(
                     key,
-                    w,
+                    short(w),
                     format!("must be <= 1000 × column.young_modulus = {limit}"),
                 ));
             }
@@ -618,6 +634,28 @@ impl StudySpec {
                 1,
                 MAX_POINTS_PER_CELL,
             )?;
+        }
+        let max_ppc = ppc.iter().copied().max().unwrap_or(1);
+        if methods.iter().any(|&m| uses_material_points(m)) {
+            for (j, &n) in elements.iter().enumerate() {
+                if n * max_ppc > MAX_POINTS_PER_CASE {
+                    return Err(c.err(
+                        format!("{}[{j}]", k("elements")),
+                        n,
+                        format!(
+                            "elements × points_per_cell ({n} × {max_ppc}) must be <= {MAX_POINTS_PER_CASE}"
+                        ),
+                    ));
+                }
+            }
+        }
+        let cases = methods.len() * weights.len() * elements.len() * ppc.len();
+        if cases > MAX_CASES_PER_SWEEP {
+            return Err(c.err(
+                prefix.trim_end_matches('.'),
+                format!("{cases} cases"),
+                format!("methods × weights × elements × points_per_cell must be <= {MAX_CASES_PER_SWEEP}"),
+            ));
         }
         Ok(())
     }

@@ -10,12 +10,16 @@
 //! case and the `timing` block).
 
 use super::rates::{compute_comparisons, compute_rates, CaseIndex, ComparisonRecord, RateRecord};
+use super::store::{case_hash, write_file, CaseStore};
+use super::vtk_output::{pvd_path, ColumnVtkWriter, VtkOptions};
 use super::{Case, StudyError, StudySpec, Tier};
 use crate::newton::NewtonSettings;
-use crate::problems::column::{solve_column, Method, PointRecord};
+use crate::problems::column::{solve_column_observed, ColumnObserver, ColumnSpec, Method, PointRecord};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// Header of the per-case point files.
@@ -161,6 +165,8 @@ impl StudyResults {
 pub struct StudyRun {
     pub results: StudyResults,
     pub points: Vec<Vec<PointRecord>>,
+    /// Cases taken from the case store instead of being solved (`--resume`).
+    pub resumed: usize,
 }
 
 fn finite(x: f64) -> Option<f64> {
@@ -169,6 +175,12 @@ fn finite(x: f64) -> Option<f64> {
 
 /// Solve one case.
 pub fn run_case(case: &Case) -> (CaseRecord, Vec<PointRecord>) {
+    run_case_observed(case, &mut |_, _| {})
+}
+
+/// [`run_case`], showing the solver to `observer` before the first and after every converged
+/// load step.
+pub fn run_case_observed(case: &Case, observer: &mut ColumnObserver<'_>) -> (CaseRecord, Vec<PointRecord>) {
     let start = Instant::now();
     let mut rec = CaseRecord {
         id: case.id.clone(),
@@ -192,7 +204,7 @@ pub fn run_case(case: &Case) -> (CaseRecord, Vec<PointRecord>) {
         steps: vec![],
         wall_seconds: 0.0,
     };
-    let points = match solve_column(&case.spec, case.method) {
+    let points = match solve_column_observed(&case.spec, case.method, observer) {
         Err(e) => {
             rec.failure = Some(FailureRecord {
                 step: 0,
@@ -248,34 +260,149 @@ pub fn run_case(case: &Case) -> (CaseRecord, Vec<PointRecord>) {
 }
 
 /// Solve every case of the tier. `on_case_done` is called (from worker threads) after each
-/// case, e.g. to advance a progress bar.
+/// case, e.g. to advance a progress bar. Nothing is written; see [`run_study_in`].
 pub fn run_study(
     spec: &StudySpec,
     study_file: &str,
     tier: Tier,
     on_case_done: &(dyn Fn(&CaseRecord) + Sync),
 ) -> StudyRun {
+    run_cases(
+        spec,
+        study_file,
+        tier,
+        &|c: &Case| Ok((run_case(c), false)),
+        on_case_done,
+    )
+    .unwrap_or_else(|e: StudyError| unreachable!("in-memory run failed: {e}"))
+}
+
+/// Options of [`run_study_in`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOptions {
+    /// Output folder; the study writes into `<out>/<name>/`.
+    pub out: PathBuf,
+    /// Reuse the stored record of a case whose inputs hash equally (see [`case_definition_hash`]).
+    pub resume: bool,
+    /// Write ParaView files of every case.
+    pub vtk: Option<VtkOptions>,
+}
+
+/// What the case store keeps of a finished column case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StoredCase {
+    pub record: CaseRecord,
+    pub points: Vec<PointRecord>,
+}
+
+/// The inputs that determine a case's results.
+#[derive(Serialize)]
+struct CaseDefinition<'a> {
+    id: &'a str,
+    method: Method,
+    points_per_cell: Option<usize>,
+    spec: &'a ColumnSpec,
+}
+
+/// Stable hash of a case's inputs (id, method, points per cell and the full [`ColumnSpec`]),
+/// [`case_hash`] of their canonical JSON.
+pub fn case_definition_hash(case: &Case) -> String {
+    case_hash(&CaseDefinition {
+        id: &case.id,
+        method: case.method,
+        points_per_cell: case.points_per_cell,
+        spec: &case.spec,
+    })
+}
+
+/// Solve every case of the tier, storing each finished case atomically in
+/// `<out>/<name>/cases/` as soon as it is done; with `resume`, cases stored earlier with the
+/// same input hash (and, with VTK output, whose `.pvd` exists) are read back instead of
+/// solved. `write_outputs` then writes `results.json` and the point files.
+pub fn run_study_in(
+    spec: &StudySpec,
+    study_file: &str,
+    tier: Tier,
+    options: &RunOptions,
+    on_case_done: &(dyn Fn(&CaseRecord) + Sync),
+) -> Result<StudyRun, StudyError> {
+    let dir = study_dir(&options.out, &spec.name);
+    let store = CaseStore::open(&dir.join("cases"))?;
+    let solve = |case: &Case| -> Result<((CaseRecord, Vec<PointRecord>), bool), StudyError> {
+        let hash = case_definition_hash(case);
+        let vtk_done = match options.vtk {
+            Some(_) => pvd_path(&dir, &case.id)?.exists(),
+            None => true,
+        };
+        if options.resume && vtk_done {
+            if let Some(s) = store.load::<StoredCase>(&case.id, &hash) {
+                return Ok(((s.record, s.points), true));
+            }
+        }
+        let (record, points) = match options.vtk {
+            None => run_case(case),
+            Some(v) => {
+                let mut w = ColumnVtkWriter::new(&dir, &case.id, case.spec.load_steps, v)?;
+                let out = run_case_observed(case, &mut |step, state| w.observe(step, state));
+                w.finish()?;
+                out
+            }
+        };
+        let stored = StoredCase { record, points };
+        store.save(&case.id, &hash, &stored)?;
+        Ok(((stored.record, stored.points), false))
+    };
+    run_cases(spec, study_file, tier, &solve, on_case_done)
+}
+
+type CaseOutput = ((CaseRecord, Vec<PointRecord>), bool);
+
+/// Run `solve` over the cases in parallel (largest first) and put the records back in case
+/// order; the first error (in case order) is returned.
+fn run_cases(
+    spec: &StudySpec,
+    study_file: &str,
+    tier: Tier,
+    solve: &(dyn Fn(&Case) -> Result<CaseOutput, StudyError> + Sync),
+    on_case_done: &(dyn Fn(&CaseRecord) + Sync),
+) -> Result<StudyRun, StudyError> {
     let start = Instant::now();
     let cases = spec.cases(tier);
     // Largest cases first so that the last one to start is short.
     let mut order: Vec<usize> = (0..cases.len()).collect();
     let cost = |c: &Case| c.spec.elements * c.points_per_cell.unwrap_or(3) * c.spec.load_steps;
     order.sort_by_key(|&i| std::cmp::Reverse(cost(&cases[i])));
+    let resumed = AtomicUsize::new(0);
+    let first_error: Mutex<Option<(usize, StudyError)>> = Mutex::new(None);
     let mut solved: Vec<(usize, CaseRecord, Vec<PointRecord>)> = order
         .par_iter()
-        .map(|&i| {
-            let (rec, pts) = run_case(&cases[i]);
-            on_case_done(&rec);
-            (i, rec, pts)
+        .filter_map(|&i| match solve(&cases[i]) {
+            Ok(((rec, pts), reused)) => {
+                if reused {
+                    resumed.fetch_add(1, Ordering::Relaxed);
+                }
+                on_case_done(&rec);
+                Some((i, rec, pts))
+            }
+            Err(e) => {
+                let mut slot = first_error.lock().unwrap_or_else(|p| p.into_inner());
+                if slot.as_ref().is_none_or(|(j, _)| i < *j) {
+                    *slot = Some((i, e));
+                }
+                None
+            }
         })
         .collect();
+    if let Some((_, e)) = first_error.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        return Err(e);
+    }
     solved.sort_by_key(|s| s.0);
     let (records, points): (Vec<CaseRecord>, Vec<Vec<PointRecord>>) =
         solved.into_iter().map(|(_, r, p)| (r, p)).unzip();
     let index = spec.case_index(tier);
     let rates = compute_rates(spec, tier, &records, &index);
     let comparisons = compute_comparisons(spec, tier, &records, &index);
-    StudyRun {
+    Ok(StudyRun {
         results: StudyResults {
             software: Software {
                 name: env!("CARGO_PKG_NAME").to_string(),
@@ -294,7 +421,8 @@ pub fn run_study(
             },
         },
         points,
-    }
+        resumed: resumed.into_inner(),
+    })
 }
 
 /// Folder of a study's outputs: `<out>/<name>`.
@@ -360,7 +488,8 @@ pub fn read_points_csv(path: &Path) -> Result<Vec<Vec<f64>>, StudyError> {
         .collect()
 }
 
-/// Write `results.json` and `points/*.csv` (stale point files of earlier runs are removed).
+/// Write `results.json` and `points/*.csv` atomically (stale point files of earlier runs are
+/// removed).
 pub fn write_outputs(out: &Path, run: &StudyRun) -> Result<PathBuf, StudyError> {
     let dir = study_dir(out, &run.results.study.name);
     let pdir = dir.join("points");
@@ -375,13 +504,12 @@ pub fn write_outputs(out: &Path, run: &StudyRun) -> Result<PathBuf, StudyError> 
         if case.status == CaseStatus::Rejected {
             continue;
         }
-        let p = dir.join(points_file(&case.id));
+        let p = super::store::confined(&pdir, &format!("{}.csv", case.id))?;
         let plastic = run.results.study.column.yield_stress.is_some();
-        std::fs::write(&p, points_csv(pts, plastic)).map_err(|e| StudyError::io(&p, e))?;
+        write_file(&p, points_csv(pts, plastic).as_bytes())?;
     }
     let json = serde_json::to_string_pretty(&run.results).map_err(|e| StudyError::io(&dir, e))?;
-    let p = dir.join("results.json");
-    std::fs::write(&p, json + "\n").map_err(|e| StudyError::io(&p, e))?;
+    write_file(&dir.join("results.json"), (json + "\n").as_bytes())?;
     Ok(dir)
 }
 

@@ -1,0 +1,147 @@
+//! `study --vtk`: ParaView files of each case of a column study.
+//!
+//! Layout inside the study folder: `vtk/<case-id>.pvd` (a collection with time = load factor,
+//! part 0 the material or Gauss points, part 1 the background grid or FEM mesh) and
+//! `vtk/<case-id>/{points,grid}_<step>.vtu` for step 0 (initial state), every `every`-th load
+//! step and the last converged step. The point arrays are those of [`crate::vtk`]; the MPM
+//! grid carries `displacement_increment` (Δu of the step) and `displacement` (Σ Δu over the
+//! steps at the fixed node; the grid itself never moves), the FEM mesh its nodal
+//! `displacement`.
+
+use super::store::confined;
+use super::StudyError;
+use crate::problems::column::ColumnState;
+use crate::vtk::{self, pad3, PvdEntry, UnstructuredGrid};
+use std::path::{Path, PathBuf};
+
+/// Which load steps to write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct VtkOptions {
+    /// Also write every `every`-th load step (0: only the initial and the final state).
+    pub every: usize,
+}
+
+/// Folder of a study's VTK files.
+pub fn vtk_dir(study_dir: &Path) -> PathBuf {
+    study_dir.join("vtk")
+}
+
+/// `.pvd` file of a case.
+pub fn pvd_path(study_dir: &Path, case_id: &str) -> Result<PathBuf, StudyError> {
+    confined(&vtk_dir(study_dir), &format!("{case_id}.pvd"))
+}
+
+/// Writes the VTK files of one column case as the solver reports its steps.
+pub struct ColumnVtkWriter {
+    root: PathBuf,
+    case_id: String,
+    case_dir: PathBuf,
+    load_steps: usize,
+    options: VtkOptions,
+    entries: Vec<PvdEntry>,
+    /// Σ Δu at the grid nodes (MPM).
+    total_du: Vec<f64>,
+    /// The last state seen but not yet written (the final step is always written).
+    pending: Option<(usize, UnstructuredGrid, UnstructuredGrid)>,
+    error: Option<StudyError>,
+}
+
+impl ColumnVtkWriter {
+    /// A writer for case `case_id` into `<study_dir>/vtk/`; stale files of the case are
+    /// removed.
+    pub fn new(
+        study_dir: &Path,
+        case_id: &str,
+        load_steps: usize,
+        options: VtkOptions,
+    ) -> Result<Self, StudyError> {
+        let root = vtk_dir(study_dir);
+        let case_dir = confined(&root, case_id)?;
+        if case_dir.exists() {
+            std::fs::remove_dir_all(&case_dir).map_err(|e| StudyError::io(&case_dir, e))?;
+        }
+        std::fs::create_dir_all(&case_dir).map_err(|e| StudyError::io(&case_dir, e))?;
+        Ok(Self {
+            root,
+            case_id: case_id.to_string(),
+            case_dir,
+            load_steps: load_steps.max(1),
+            options,
+            entries: vec![],
+            total_du: vec![],
+            pending: None,
+            error: None,
+        })
+    }
+
+    /// Record the solver state after `step` (0: initial).
+    pub fn observe(&mut self, step: usize, state: ColumnState<'_>) {
+        if self.error.is_some() {
+            return;
+        }
+        let (points, grid) = match state {
+            ColumnState::Mpm(s) => {
+                let du = s.step_increment();
+                if step > 0 {
+                    self.total_du.resize(du.len(), 0.0);
+                    self.total_du.iter_mut().zip(du).for_each(|(t, d)| *t += d);
+                }
+                let zeros = vec![0.0; s.grid.num_nodes()];
+                let (inc, tot) = if step == 0 || du.len() != zeros.len() {
+                    (&zeros[..], &zeros[..])
+                } else {
+                    (du, &self.total_du[..])
+                };
+                let grid =
+                    vtk::background_grid(&s.grid, &[("displacement_increment", inc), ("displacement", tot)]);
+                (vtk::material_points(&s.points), grid)
+            }
+            ColumnState::Fem(s) => {
+                let g = &s.gauss;
+                let x: Vec<[f64; 3]> = (0..g.len())
+                    .map(|p| pad3(&nalgebra::SVector::<f64, 1>::new(s.gauss_point_map(p).0)))
+                    .collect();
+                let x0: Vec<[f64; 3]> = g.position0.iter().map(|&z| [z, 0.0, 0.0]).collect();
+                let points = vtk::gauss_points(&x, &x0, &g.volume0, &g.state);
+                (points, vtk::line_mesh(&s.mesh, &s.mesh0))
+            }
+        };
+        let due = step == 0 || (self.options.every > 0 && step % self.options.every == 0);
+        if due {
+            self.pending = None;
+            self.write(step, &points, &grid);
+        } else {
+            self.pending = Some((step, points, grid));
+        }
+    }
+
+    fn write(&mut self, step: usize, points: &UnstructuredGrid, grid: &UnstructuredGrid) {
+        let time = step as f64 / self.load_steps as f64;
+        for (part, (stem, data)) in [("points", points), ("grid", grid)].into_iter().enumerate() {
+            let name = format!("{stem}_{step:05}.vtu");
+            let path = self.case_dir.join(&name);
+            if let Err(e) = vtk::write_vtu(&path, data) {
+                self.error = Some(StudyError::io(&path, e));
+                return;
+            }
+            self.entries.push(PvdEntry {
+                time,
+                part,
+                file: format!("{}/{name}", self.case_id),
+            });
+        }
+    }
+
+    /// Write the last state if it is still pending, and the `.pvd` collection.
+    pub fn finish(mut self) -> Result<PathBuf, StudyError> {
+        if let Some((step, p, g)) = self.pending.take() {
+            self.write(step, &p, &g);
+        }
+        if let Some(e) = self.error {
+            return Err(e);
+        }
+        let path = confined(&self.root, &format!("{}.pvd", self.case_id))?;
+        vtk::write_pvd(&path, &self.entries).map_err(|e| StudyError::io(&path, e))?;
+        Ok(path)
+    }
+}

@@ -1,0 +1,352 @@
+//! The `study` binary as a researcher uses it: ParaView output read back by an independent
+//! reader (Python meshio), a sweep killed part-way and resumed, and results that do not
+//! depend on the number of threads.
+
+use igimp::study::runner::{read_points_csv, read_results, StudyResults};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn study_bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_study"))
+}
+
+/// A column study with three small cases (iGIMP, MPM, quadratic FEM).
+const TINY: &str = r#"
+schema = 1
+name = "tiny"
+summary = "three small column cases"
+problem = "column"
+report_file = "table.md"
+load_steps = 4
+[column]
+length = 50.0
+young_modulus = 1.0e6
+poisson_ratio = 0.0
+density = 80.0
+yield_stress = 20000.0
+[newton]
+tolerance = 1.0e-9
+max_iterations = 30
+[[sweeps]]
+id = "a"
+title = "small cases"
+methods = ["igimp", "mpm", "fem-quadratic"]
+weights = [40000.0]
+elements = [8]
+points_per_cell = [2]
+"#;
+
+/// Six iGIMP cases of 0.1-0.6 s each on one thread: long enough to kill the run between cases.
+const SLOW: &str = r#"
+schema = 1
+name = "slow"
+summary = "resume test"
+problem = "column"
+report_file = "table.md"
+load_steps = 20
+[column]
+length = 50.0
+young_modulus = 1.0e6
+poisson_ratio = 0.0
+density = 80.0
+[newton]
+tolerance = 1.0e-9
+max_iterations = 30
+[[sweeps]]
+id = "big"
+title = "big cases"
+methods = ["igimp"]
+weights = [40000.0]
+elements = [1024, 2048]
+points_per_cell = [2, 3, 4]
+"#;
+
+fn write_study(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let studies = dir.join("studies");
+    std::fs::create_dir_all(&studies).unwrap();
+    std::fs::write(studies.join(format!("{name}.toml")), text).unwrap();
+    studies
+}
+
+fn run(dir: &Path, name: &str, out: &str, threads: usize, extra: &[&str]) -> String {
+    let output = study_bin()
+        .arg(name)
+        .arg("--studies-dir")
+        .arg(dir.join("studies"))
+        .arg("--out")
+        .arg(dir.join(out))
+        .args(extra)
+        .env("RAYON_NUM_THREADS", threads.to_string())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert!(output.status.success(), "study {name} failed:\n{stderr}");
+    stderr
+}
+
+fn results(dir: &Path, out: &str, name: &str) -> StudyResults {
+    read_results(&dir.join(out).join(name)).unwrap()
+}
+
+/// Is `python3 -c "import meshio"` available? In CI (`CI=true`) its absence is a failure.
+fn meshio_available() -> bool {
+    let ok = Command::new("python3")
+        .args(["-c", "import meshio"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !ok {
+        let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
+        assert!(!ci, "python3 with meshio is required in CI (.ci/run installs it)");
+        eprintln!("SKIPPED: python3 with the meshio package is not available (pip install meshio)");
+    }
+    ok
+}
+
+/// Read VTU files with meshio: for each file its points, cell blocks and point arrays.
+fn meshio_read(files: &[PathBuf]) -> Value {
+    const SCRIPT: &str = r#"
+import json, sys, meshio
+out = {}
+for path in sys.argv[1:]:
+    m = meshio.read(path)
+    out[path] = {
+        "points": m.points.tolist(),
+        "cells": [[c.type, c.data.tolist()] for c in m.cells],
+        "data": {k: v.tolist() for k, v in m.point_data.items()},
+    }
+print(json.dumps(out))
+"#;
+    let output = Command::new("python3")
+        .arg("-c")
+        .arg(SCRIPT)
+        .args(files)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "meshio failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).unwrap()
+}
+
+fn column(v: &Value, name: &str, component: usize) -> Vec<f64> {
+    v["data"][name]
+        .as_array()
+        .unwrap_or_else(|| panic!("no array {name}"))
+        .iter()
+        .map(|row| row[component].as_f64().unwrap())
+        .collect()
+}
+
+/// `--vtk` files of the final state, read by meshio, hold exactly the point values of the
+/// point CSVs and reproduce results.json's top displacement; the grid/mesh has one cell per
+/// element.
+#[test]
+fn vtk_output_read_by_meshio_matches_results_json_and_point_files() {
+    if !meshio_available() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    write_study(tmp.path(), "tiny", TINY);
+    run(tmp.path(), "tiny", "out", 2, &["--vtk-every", "2"]);
+    let sdir = tmp.path().join("out/tiny");
+    let res = read_results(&sdir).unwrap();
+    assert_eq!(res.cases.len(), 3);
+    for case in &res.cases {
+        let pvd = std::fs::read_to_string(sdir.join(format!("vtk/{}.pvd", case.id))).unwrap();
+        // Steps 0, 2 and 4, each with points and grid.
+        assert_eq!(pvd.matches("<DataSet").count(), 6, "{pvd}");
+        let pts_file = sdir.join(format!("vtk/{}/points_00004.vtu", case.id));
+        let grid_file = sdir.join(format!("vtk/{}/grid_00004.vtu", case.id));
+        let all = meshio_read(&[pts_file.clone(), grid_file.clone()]);
+        let pts = &all[pts_file.to_str().unwrap()];
+        let grid = &all[grid_file.to_str().unwrap()];
+        let csv = read_points_csv(&sdir.join(format!("points/{}.csv", case.id))).unwrap();
+        assert_eq!(csv.len(), case.points);
+        let x: Vec<f64> = pts["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p[0].as_f64().unwrap())
+            .collect();
+        let z0 = column(pts, "position0", 0);
+        let v0 = column(pts, "volume0", 0);
+        let s_zz = column(pts, "cauchy_stress", 0);
+        let s_xx = column(pts, "cauchy_stress", 4);
+        let f_zz = column(pts, "deformation_gradient", 0);
+        let u = column(pts, "displacement", 0);
+        let tau = column(pts, "kirchhoff_stress", 0);
+        let lam = column(pts, "plastic_multiplier", 0);
+        assert_eq!(x.len(), csv.len());
+        // CSV columns: z0, z, volume0, sigma_zz, f_zz, sigma_xx (shortest round-trip text in
+        // both files, so equality is exact).
+        for (p, row) in csv.iter().enumerate() {
+            assert_eq!(
+                [z0[p], x[p], v0[p], s_zz[p], f_zz[p], s_xx[p]],
+                row[..6],
+                "{} point {p}",
+                case.id
+            );
+            assert_eq!(u[p], x[p] - z0[p]);
+            // τ = σ J with J = F_zz in uniaxial strain.
+            assert!((tau[p] - s_zz[p] * f_zz[p]).abs() <= 1e-9 * tau[p].abs());
+        }
+        assert!(
+            lam.iter().any(|&l| l > 0.0),
+            "{}: the plastic column yields",
+            case.id
+        );
+        let top = z0
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(p, _)| u[p])
+            .unwrap();
+        let cells = grid["cells"].as_array().unwrap();
+        let grid_u = column(grid, "displacement", 0);
+        if case.method.name().starts_with("fem") {
+            assert_eq!(cells[0][0], "line3");
+            assert_eq!(cells[0][1].as_array().unwrap().len(), 8);
+            // FEM: results.json's top displacement is that of the top node.
+            assert_eq!(Some(*grid_u.last().unwrap()), case.top_displacement);
+        } else {
+            assert_eq!(cells[0][0], "line");
+            assert_eq!(cells[0][1].as_array().unwrap().len(), 8);
+            assert_eq!(Some(top), case.top_displacement);
+            let extent = column(pts, "domain_extent", 0);
+            let total: f64 = extent.iter().sum();
+            assert!(
+                (total - (50.0 + top)).abs() < 1e-2 * 50.0,
+                "domains cover the column"
+            );
+            assert!(grid_u.iter().any(|&v| v < 0.0), "grid displacement is written");
+        }
+    }
+}
+
+fn resumed_count(stderr: &str) -> (usize, usize) {
+    let line = stderr
+        .lines()
+        .find(|l| l.contains("resumed"))
+        .unwrap_or_else(|| panic!("no resume line in:\n{stderr}"));
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let at = words.iter().position(|w| *w == "resumed").unwrap();
+    (words[at + 1].parse().unwrap(), words[at + 3].parse().unwrap())
+}
+
+/// A run killed after its first finished case, rerun with `--resume`, reuses the finished
+/// cases, solves the rest and ends with the results.json of an uninterrupted run (wall times
+/// aside). Killed on one thread, uninterrupted on two: also a thread-count check.
+#[test]
+fn killed_sweep_resumes_to_the_uninterrupted_results() {
+    let tmp = tempfile::tempdir().unwrap();
+    write_study(tmp.path(), "slow", SLOW);
+    let cases = tmp.path().join("killed/slow/cases");
+    let mut child = study_bin()
+        .args(["slow", "--studies-dir"])
+        .arg(tmp.path().join("studies"))
+        .arg("--out")
+        .arg(tmp.path().join("killed"))
+        .env("RAYON_NUM_THREADS", "1")
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let finished = |d: &Path| {
+        std::fs::read_dir(d).map_or(0, |r| {
+            r.filter_map(|e| e.ok())
+                .filter(|e| e.path().extension().is_some_and(|x| x == "json"))
+                .count()
+        })
+    };
+    while finished(&cases) == 0 {
+        assert!(start.elapsed() < Duration::from_secs(120), "no case finished");
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "run ended before a case was seen"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        !tmp.path().join("killed/slow/results.json").exists(),
+        "the run finished before it was killed; the cases are too small for this machine"
+    );
+    let stderr = run(tmp.path(), "slow", "killed", 2, &["--resume"]);
+    let (resumed, total) = resumed_count(&stderr);
+    assert_eq!(total, 6);
+    assert!((1..total).contains(&resumed), "resumed {resumed} of {total}");
+
+    run(tmp.path(), "slow", "clean", 2, &[]);
+    let a = results(tmp.path(), "killed", "slow");
+    let b = results(tmp.path(), "clean", "slow");
+    assert_eq!(a.without_timing(), b.without_timing());
+    for c in &a.cases {
+        let p = format!("slow/points/{}.csv", c.id);
+        let pa = std::fs::read(tmp.path().join("killed").join(&p)).unwrap();
+        let pb = std::fs::read(tmp.path().join("clean").join(&p)).unwrap();
+        assert_eq!(pa, pb, "{p}");
+    }
+    // A second --resume solves nothing.
+    let stderr = run(tmp.path(), "slow", "killed", 2, &["--resume"]);
+    assert_eq!(resumed_count(&stderr), (6, 6));
+    // A changed input is solved again: only the cases whose definition changed.
+    write_study(
+        tmp.path(),
+        "slow",
+        &SLOW.replace("tolerance = 1.0e-9", "tolerance = 1.0e-10"),
+    );
+    let stderr = run(tmp.path(), "slow", "killed", 2, &["--resume"]);
+    assert_eq!(resumed_count(&stderr), (0, 6));
+}
+
+/// The quick tier of both column studies gives identical results.json numbers and point
+/// files on one and on two threads; only the `timing` block and `wall_seconds` differ.
+#[test]
+fn results_identical_on_one_and_two_threads() {
+    let tmp = tempfile::tempdir().unwrap();
+    let studies = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies");
+    for (threads, out) in [(1, "t1"), (2, "t2")] {
+        let o = study_bin()
+            .args(["column", "column-plastic", "--quick", "--studies-dir"])
+            .arg(&studies)
+            .arg("--out")
+            .arg(tmp.path().join(out))
+            .env("RAYON_NUM_THREADS", threads.to_string())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    for name in ["column", "column-plastic"] {
+        let a = results(tmp.path(), "t1", name);
+        let b = results(tmp.path(), "t2", name);
+        assert_eq!(a.timing.threads, 1);
+        assert_eq!(b.timing.threads, 2);
+        assert_eq!(a.without_timing(), b.without_timing(), "{name}");
+        // Byte-level: the JSON text differs only in wall-clock fields.
+        let strip = |out: &str| -> Value {
+            let text = std::fs::read_to_string(tmp.path().join(out).join(name).join("results.json")).unwrap();
+            let mut v: Value = serde_json::from_str(&text).unwrap();
+            v["timing"] = Value::Null;
+            for c in v["cases"].as_array_mut().unwrap() {
+                c["wall_seconds"] = Value::Null;
+            }
+            v
+        };
+        assert_eq!(strip("t1"), strip("t2"), "{name}");
+        for c in &a.cases {
+            let p = format!("{name}/points/{}.csv", c.id);
+            assert_eq!(
+                std::fs::read(tmp.path().join("t1").join(&p)).unwrap(),
+                std::fs::read(tmp.path().join("t2").join(&p)).unwrap(),
+                "{p}"
+            );
+        }
+    }
+}
