@@ -47,7 +47,7 @@ fn point_kernel(c: &mut Criterion) {
             black_box(
                 evaluate_point::<1>(&model, &state, black_box(&g1))
                     .unwrap()
-                    .spatial_tangent(),
+                    .spatial_tangent(&model, &state),
             )
         })
     });
@@ -56,7 +56,7 @@ fn point_kernel(c: &mut Criterion) {
             black_box(
                 evaluate_point::<2>(&model, &state, black_box(&g2))
                     .unwrap()
-                    .spatial_tangent(),
+                    .spatial_tangent(&model, &state),
             )
         })
     });

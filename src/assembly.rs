@@ -191,11 +191,20 @@ impl DofMap {
     }
 
     /// Sparsity pattern (per column, the rows) coupling every pair of free dofs that share a point.
+    ///
+    /// A point whose node list equals the previous point's adds nothing and is skipped: the
+    /// Gauss points of one element (and material points of one cell) come in runs, so this
+    /// divides the transient storage by the points per element on large meshes.
     pub fn pattern<const D: usize>(&self, table: &SupportTable<D>) -> Vec<Vec<usize>> {
         let mut columns: Vec<Vec<usize>> = vec![Vec::new(); self.count];
         let mut eqs = Vec::with_capacity(MAX_POINT_NODES * D);
+        let mut previous: &[usize] = &[];
         for p in 0..table.num_points() {
             let (nodes, _, _) = table.point(p);
+            if nodes == previous {
+                continue;
+            }
+            previous = nodes;
             eqs.clear();
             for &n in nodes {
                 for a in 0..D {
@@ -328,7 +337,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         for p in 0..self.states.len() {
             let t = self.trials[p].as_ref().expect("evaluated");
             let m = self.spatial_gradients(p, t, &mut gx, &mut eqs);
-            let a = t.spatial_tangent();
+            let a = t.spatial_tangent(self.model, &self.states[p]);
             let v = t.volume;
             // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V.
             for kb in 0..m {

@@ -246,7 +246,7 @@ pub struct PointTrial<const D: usize> {
     pub volume: f64,
     /// Inverse of the in-plane block of ΔF, mapping ∂/∂X̃ to ∂/∂x (eqs 35–36).
     pub delta_f_inv: SMatrix<f64, D, D>,
-    /// Constitutive response (τ, ε^e, D^alg).
+    /// Constitutive response (τ, ε^e, plastic multiplier).
     pub response: MaterialResponse,
     /// Eigenvalues of the trial b^e.
     pub b_trial_eigenvalues: Vector3<f64>,
@@ -322,10 +322,19 @@ pub fn evaluate_point<const D: usize>(
 }
 
 impl<const D: usize> PointTrial<D> {
-    /// Spatial tangent a_ijkl, eq (25), at this trial state (active components only).
-    pub fn spatial_tangent(&self) -> Tensor4 {
+    /// Trial elastic log strain ε^e_t = ½ ln b^e_t, eq (19).
+    pub fn eps_trial(&self) -> Matrix3<f64> {
+        spectral_map(&self.b_trial_eigenvalues, &self.b_trial_eigenvectors, |l| {
+            0.5 * l.ln()
+        })
+    }
+
+    /// Spatial tangent a_ijkl, eq (25), at this trial state (active components only);
+    /// `committed` is the state the trial was evaluated from.
+    pub fn spatial_tangent(&self, model: &dyn ConstitutiveModel, committed: &PointState) -> Tensor4 {
+        let d_alg = model.tangent(&self.eps_trial(), &committed.material);
         spatial_tangent_eigen::<D>(
-            &self.response.d_alg,
+            &d_alg,
             &self.b_trial_eigenvalues,
             &self.b_trial_eigenvectors,
             &self.sigma,

@@ -8,10 +8,11 @@
 //! [`grid`] (regular background grid) → [`basis`] (MPM / GIMP weights, eqs 7–10) →
 //! [`assembly`] (per-point residual and tangent, eqs 27–29, 36, 41) with [`kinematics`]
 //! (ΔF, log strain, spatial tangent; eqs 15–19, 25, 30–36) and [`constitutive`] (eq 14) →
-//! [`linear`] (sparse LU with cached symbolic factorisation) → [`newton`] (eqs 22–23) →
-//! [`mpm`] (load steps, commit, domain update eqs 37–39). [`fem`] runs the same
-//! assembly, kinematics and Newton on Gauss points of updated-Lagrangian line elements
-//! ([`quadrature`]), the paper's comparators. [`problems`] holds the paper's
+//! [`linear`] (sparse LU, or LDLᵀ/LLᵀ for symmetric tangents, with cached symbolic
+//! factorisation) → [`newton`] (eqs 22–23) → [`mpm`] (load steps, commit, domain update
+//! eqs 37–39). [`fem`] runs the same assembly, kinematics and Newton on Gauss points
+//! ([`quadrature`]) of updated-Lagrangian line and plane-strain quadrilateral elements, the
+//! paper's comparators. [`problems`] holds the paper's
 //! examples with their analytical solutions; [`norms`] the error measures (eqs 46–47).
 //!
 //! Verification studies are data (`studies/*.toml`): [`study`] parses them and runs the
@@ -26,7 +27,7 @@
 //! | F, ΔF | `PointState::f`, `PointTrial::delta_f` |
 //! | b^e, ε^e | `MaterialState::b_e`, `MaterialState::eps_e` |
 //! | τ, σ | `MaterialResponse::tau`, `PointTrial::sigma` |
-//! | D^alg, a_ijkl | `MaterialResponse::d_alg`, `PointTrial::tangent` |
+//! | D^alg, a_ijkl | `ConstitutiveModel::tangent`, `PointTrial::spatial_tangent` |
 //! | V_p, V_p^n | `PointTrial::volume`, `PointState::volume` |
 //! | l_p | `MaterialPoints::half_length` (half of l_p) |
 

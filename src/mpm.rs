@@ -41,6 +41,10 @@ pub struct MpmSettings {
     pub weak_node_treatment: WeakNodeTreatment,
     #[serde(default)]
     pub volume_update: VolumeUpdate,
+    /// Sparse factorisation of the tangent: LU (default) or, for the symmetric tangents of
+    /// hyperelastic and associative plastic models, LDLᵀ/LLᵀ with LU as fallback.
+    #[serde(default)]
+    pub linear_solver: crate::linear::LinearSolver,
 }
 
 /// How the committed volume V_p^n of a material point is obtained (eq 28).
@@ -339,6 +343,7 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
             point_forces: &forces,
             nodal_forces: &[],
         };
+        self.work.matrix.set_solver(self.settings.linear_solver);
         let report = self
             .work
             .solve(&input, &self.settings.newton)

@@ -151,9 +151,9 @@ pub fn profile_svg(
     x_desc: &str,
     y_desc: &str,
     series: &[ProfileSeries],
-    analytical: &[(f64, f64)],
+    analytical: &[ProfileSeries],
 ) -> PlotResult<String> {
-    let all = series.iter().flat_map(|s| s.points.iter()).chain(analytical);
+    let all = series.iter().chain(analytical).flat_map(|s| s.points.iter());
     let (mut x0, mut x1, mut y0, mut y1) =
         (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
     for &(x, y) in all {
@@ -191,12 +191,17 @@ pub fn profile_svg(
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(err)?;
-        if !analytical.is_empty() {
+        for (i, curve) in analytical.iter().enumerate() {
+            let style = if i == 0 {
+                BLACK.stroke_width(2)
+            } else {
+                RGBColor(110, 110, 110).stroke_width(2)
+            };
             chart
-                .draw_series(LineSeries::new(analytical.iter().copied(), BLACK.stroke_width(2)))
+                .draw_series(LineSeries::new(curve.points.iter().copied(), style))
                 .map_err(err)?
-                .label("analytical, eqs (42)-(45)")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], BLACK.stroke_width(2)));
+                .label(curve.label.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
         }
         for (i, s) in series.iter().enumerate() {
             draw_markers(&mut chart, &s.points, Marker::nth(i), color(i), &s.label, false)?;

@@ -57,6 +57,7 @@ pub fn column_at(results: &StudyResults, load: f64) -> ColumnSpec {
         young_modulus: c.young_modulus,
         poisson_ratio: c.poisson_ratio,
         density: c.density,
+        yield_stress: c.yield_stress,
         weight: load,
         ..ColumnSpec::default()
     }
@@ -217,6 +218,44 @@ pub fn report_markdown(results: &StudyResults) -> String {
         s.push('\n');
     }
 
+    if let Some(ry) = spec.column.yield_stress {
+        let _ = writeln!(s, "## Yield height\n");
+        let _ = writeln!(
+            s,
+            "Yield starts where the Kirchhoff stress reaches ρy (τzz = −ρy for ν = 0), i.e. at Z_y = L0 − ρy e^(ρy/E) / (ρ0 g); \
+             the paper's L0 − ρy/(ρ0 g) equates the Cauchy stress with ρy (reference/README.md, item 6). \
+             The computed value is the finest converged iGIMP case's `yield_height`.\n"
+        );
+        let _ = writeln!(
+            s,
+            "| W | Z_y, Kirchhoff criterion (this code) | Z_y, paper's formula | finest iGIMP | elements |"
+        );
+        let _ = writeln!(s, "|---:|---:|---:|---:|---:|");
+        let mut loads: Vec<f64> = results.cases.iter().map(|c| c.load).collect();
+        loads.sort_by(f64::total_cmp);
+        loads.dedup();
+        for load in loads {
+            let column = column_at(results, load);
+            let exact = column.analytical().yield_height();
+            let paper = column.length - ry / (column.density * column.gravity());
+            let finest = results
+                .cases
+                .iter()
+                .filter(|c| c.load == load && c.method == Method::Igimp && c.yield_height.is_some())
+                .max_by_key(|c| c.elements);
+            let _ = writeln!(
+                s,
+                "| {} | {} | {paper:.4} | {} | {} |",
+                weight_label(load),
+                exact.map_or("—".into(), |z| format!("{z:.4}")),
+                finest
+                    .and_then(|c| c.yield_height)
+                    .map_or("—".into(), |z| format!("{z:.4}")),
+                finest.map_or("—".into(), |c| c.elements.to_string()),
+            );
+        }
+        s.push('\n');
+    }
     let _ = writeln!(s, "## Convergence\n");
     let _ = writeln!(
         s,
@@ -236,32 +275,64 @@ pub fn report_markdown(results: &StudyResults) -> String {
         for &load in &plan.weights {
             for (m, ppc) in sweep_series(results, &sweep.id, load) {
                 let cs = series(&results.cases, ids, m, load, ppc);
+                let plastic = spec.column.yield_stress.is_some();
+                let slopes: Vec<String> = Measure::all(plastic)
+                    .iter()
+                    .map(|&m_| {
+                        format!(
+                            "{} {}",
+                            m_.name(),
+                            rate(fitted(results, &sweep.id, m, load, ppc, m_))
+                        )
+                    })
+                    .collect();
                 let _ = writeln!(
                     s,
-                    "**{}, W = {}** (fitted slope: stress {}, F {})\n",
+                    "**{}, W = {}** (fitted slope: {})\n",
                     series_label(m, ppc),
                     weight_label(load),
-                    rate(fitted(results, &sweep.id, m, load, ppc, Measure::StressError)),
-                    rate(fitted(results, &sweep.id, m, load, ppc, Measure::FError)),
+                    slopes.join(", "),
                 );
+                let extra_head = if plastic {
+                    " σxx error | rate | yield height | Zy error |"
+                } else {
+                    ""
+                };
+                let extra_rule = if plastic { "---:|---:|---:|---:|" } else { "" };
                 let _ = writeln!(
                     s,
-                    "| elements | stress error | rate | F error | rate | top u | base F | Newton its/step | status |"
+                    "| elements | stress error | rate | F error | rate |{extra_head} top u | base F | Newton its/step | status |"
                 );
-                let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+                let _ = writeln!(s, "|---:|---:|---:|---:|---:|{extra_rule}---:|---:|---:|---|");
                 let n: Vec<usize> = cs.iter().map(|c| c.elements).collect();
                 let es: Vec<Option<f64>> = cs.iter().map(|c| case_error(c, Measure::StressError)).collect();
                 let ef: Vec<Option<f64>> = cs.iter().map(|c| case_error(c, Measure::FError)).collect();
-                let (rs, rf) = (pairwise_rates(&n, &es), pairwise_rates(&n, &ef));
+                let ex: Vec<Option<f64>> = cs.iter().map(|c| case_error(c, Measure::SigmaXxError)).collect();
+                let (rs, rf, rx) = (
+                    pairwise_rates(&n, &es),
+                    pairwise_rates(&n, &ef),
+                    pairwise_rates(&n, &ex),
+                );
                 for (i, c) in cs.iter().enumerate() {
                     let its = if c.steps.is_empty() {
                         "—".to_string()
                     } else {
                         format!("{:.2}", c.newton_iterations as f64 / c.steps.len() as f64)
                     };
+                    let extra = if plastic {
+                        format!(
+                            " {} | {} | {} | {} |",
+                            e3(ex[i]),
+                            rate(rx[i]),
+                            c.yield_height.map_or("—".into(), |v| format!("{v:.4}")),
+                            e3(case_error(c, Measure::YieldHeightError))
+                        )
+                    } else {
+                        String::new()
+                    };
                     let _ = writeln!(
                         s,
-                        "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                        "| {} | {} | {} | {} | {} |{extra} {} | {} | {} | {} |",
                         c.elements,
                         e3(es[i]),
                         rate(rs[i]),
@@ -406,25 +477,57 @@ pub fn render_figure(
                     }
                     let rows = read_points_csv(&study_dir.join(points_file(&c.id)))?;
                     series_out.push(ProfileSeries {
-                        label: format!("{}, {} elements", series_label(m, ppc), c.elements),
+                        label: format!("σzz, {}, {} elements", series_label(m, ppc), c.elements),
                         points: rows.iter().map(|r| (r[3], r[1])).collect(),
                     });
                 }
             }
-            let exact = column_at(results, fig.weight).analytical();
+            let column = column_at(results, fig.weight);
+            let exact = column.analytical();
             let l0 = results.study.column.length;
-            let curve: Vec<(f64, f64)> = (0..=200)
-                .map(|i| {
-                    let z0 = l0 * i as f64 / 200.0;
-                    (exact.stress(z0), z0 + exact.displacement(z0))
-                })
-                .collect();
+            let z0s: Vec<f64> = (0..=400).map(|i| l0 * i as f64 / 400.0).collect();
+            let height = |z0: f64| z0 + exact.displacement(z0);
+            let mut curves = vec![ProfileSeries {
+                label: "analytical σzz, eqs (42)-(45)".into(),
+                points: z0s.iter().map(|&z0| (exact.stress(z0), height(z0))).collect(),
+            }];
+            let plastic = column.yield_stress.is_some();
+            if plastic {
+                // The lateral stress is recorded in the sixth column of plastic point files.
+                for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {
+                    for c in series(&results.cases, ids, m, fig.weight, ppc) {
+                        if c.status != CaseStatus::Converged {
+                            continue;
+                        }
+                        let rows = read_points_csv(&study_dir.join(points_file(&c.id)))?;
+                        series_out.push(ProfileSeries {
+                            label: format!("σxx, {}, {} elements", series_label(m, ppc), c.elements),
+                            points: rows
+                                .iter()
+                                .filter(|r| r.len() > 5)
+                                .map(|r| (r[5], r[1]))
+                                .collect(),
+                        });
+                    }
+                }
+                curves.push(ProfileSeries {
+                    label: "analytical σxx = σyy (derived; eq 54)".into(),
+                    points: z0s
+                        .iter()
+                        .map(|&z0| (exact.lateral_stress(z0), height(z0)))
+                        .collect(),
+                });
+            }
             plot::profile_svg(
                 &fig.title,
-                "vertical Cauchy stress σzz (Pa)",
+                if plastic {
+                    "Cauchy stress σzz, σxx (Pa)"
+                } else {
+                    "vertical Cauchy stress σzz (Pa)"
+                },
                 "current height z (m)",
                 &series_out,
-                &curve,
+                &curves,
             )
             .map_err(file_err)
         }

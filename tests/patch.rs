@@ -29,6 +29,7 @@ fn patch<const D: usize>(
         weak_node_tolerance: 0.0,
         weak_node_treatment: Default::default(),
         volume_update: Default::default(),
+        linear_solver: Default::default(),
     };
     let loads = Loads {
         gravity: SVector::<f64, D>::zeros(),

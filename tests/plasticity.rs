@@ -46,7 +46,7 @@ fn von_mises_return_map_lands_on_yield_surface_and_elastic_states_pass() {
             assert!(f <= 0.0);
             assert_eq!(r.eps_e, eps);
             let lin = igimp::constitutive::LinearElastic::try_new(1e6, 0.3).unwrap();
-            assert_eq!(r.d_alg, *lin.stiffness());
+            assert_eq!(m.tangent(&eps, &MaterialState::default()), *lin.stiffness());
         }
     }
     assert!(
@@ -66,6 +66,7 @@ fn von_mises_algorithmic_tangent_matches_central_differences() {
     for _ in 0..100 {
         let eps = random_strain(&mut rng, 0.05);
         let r = m.update(&eps, &state).unwrap();
+        let d_alg = m.tangent(&eps, &state);
         let elastic = igimp::constitutive::LinearElastic::try_new(1e6, 0.3).unwrap();
         let trial_margin = m.yield_function(&contract(elastic.stiffness(), &eps));
         if trial_margin.abs() < 1e-3 * RHO_Y {
@@ -83,9 +84,9 @@ fn von_mises_algorithmic_tangent_matches_central_differences() {
                 let fd = (m.update(&(eps + d * h), &state).unwrap().tau
                     - m.update(&(eps - d * h), &state).unwrap().tau)
                     / (2.0 * h);
-                let an = contract(&r.d_alg, &d);
+                let an = contract(&d_alg, &d);
                 assert!(
-                    (fd - an).amax() <= 1e-6 * r.d_alg.amax(),
+                    (fd - an).amax() <= 1e-6 * d_alg.amax(),
                     "tangent mismatch: {fd} vs {an}"
                 );
             }

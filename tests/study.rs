@@ -398,3 +398,47 @@ measure = "stress_error"
     let table = std::fs::read_to_string(sdir.join("table.md")).unwrap();
     assert!(table.contains("failed") && table.contains(&failed.id), "{table}");
 }
+
+/// The plastic column study (issue 6) in its quick tier: every expected rate (σzz, σxx,
+/// linear FEM) lies in its band from `studies/column-plastic.toml`, iGIMP stays below linear
+/// FEM, the point files carry σxx, and the yield height of the finest iGIMP case is within
+/// 0.25 element of the analytical (Kirchhoff-criterion) value — and not the paper's formula.
+#[test]
+fn plastic_column_quick_tier_meets_its_bands_and_yield_height() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/column-plastic.toml");
+    let spec = StudySpec::load(&file).expect("plastic study parses");
+    let run = run_study(&spec, "column-plastic.toml", Tier::Quick, &|_| {});
+    let expected: Vec<&RateRecord> = run
+        .results
+        .rates
+        .iter()
+        .filter(|r| r.expected.is_some())
+        .collect();
+    assert!(expected.iter().any(|r| r.measure == Measure::SigmaXxError));
+    for r in expected {
+        assert_in_band(r);
+    }
+    for c in &run.results.comparisons {
+        assert_eq!(c.pass, Some(true), "comparison failed: {c:?}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let study_dir = write_outputs(dir.path(), &run).unwrap();
+    let finest = run
+        .results
+        .cases
+        .iter()
+        .filter(|c| c.method == Method::Igimp && c.load == 400000.0)
+        .max_by_key(|c| c.elements)
+        .unwrap();
+    let csv = std::fs::read_to_string(study_dir.join(igimp::study::runner::points_file(&finest.id))).unwrap();
+    assert!(csv.starts_with("z0,z,volume0,sigma_zz,f_zz,sigma_xx\n"));
+    let zy = finest.yield_height.expect("yield height");
+    let h = 50.0 / finest.elements as f64;
+    assert!((zy - 46.135795).abs() < 0.25 * h, "yield height {zy}");
+    assert!(
+        (zy - 46.25).abs() > 5.0 * (zy - 46.135795).abs(),
+        "yield height {zy} is not clearly closer to the Kirchhoff criterion than to the paper's formula"
+    );
+    report::render_study(&study_dir).unwrap();
+    assert!(study_dir.join("fig13.svg").exists() && study_dir.join("table.md").exists());
+}

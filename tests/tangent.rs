@@ -68,7 +68,7 @@ fn constitutive_tangent_matches_central_differences() {
     for _ in 0..20 {
         let a = Matrix3::from_fn(|_, _| rng.uniform(-0.05, 0.05));
         let eps = 0.5 * (a + a.transpose());
-        let resp = model.update(&eps, &state).unwrap();
+        model.update(&eps, &state).unwrap();
         let h = 1e-7;
         for k in 0..3 {
             for l in 0..3 {
@@ -78,8 +78,9 @@ fn constitutive_tangent_matches_central_differences() {
                 let fd = (model.update(&(eps + d * h), &state).unwrap().tau
                     - model.update(&(eps - d * h), &state).unwrap().tau)
                     / (2.0 * h);
-                let an = contract(&resp.d_alg, &d);
-                assert!((fd - an).amax() <= 1e-6 * resp.d_alg.amax(), "D^alg mismatch");
+                let d_alg = model.tangent(&eps, &state);
+                let an = contract(&d_alg, &d);
+                assert!((fd - an).amax() <= 1e-6 * d_alg.amax(), "D^alg mismatch");
             }
         }
     }
@@ -191,6 +192,7 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
             weak_node_tolerance: 0.0,
             weak_node_treatment: Default::default(),
             volume_update: Default::default(),
+            linear_solver: Default::default(),
         };
         let loads = Loads {
             gravity: SVector::<f64, 2>::zeros(),
@@ -254,8 +256,9 @@ fn spatial_tangent_eigen_form_equals_literal_eq25() {
         let resp = model.update(&eps, &MaterialState::default()).unwrap();
         let j = 1.3;
         let sigma = resp.tau / j;
-        let literal = spatial_tangent::<2>(&resp.d_alg, &dlog(&lam, &q), &b, &sigma, j);
-        let fast = spatial_tangent_eigen::<2>(&resp.d_alg, &lam, &q, &sigma, j);
+        let d_alg = model.tangent(&eps, &MaterialState::default());
+        let literal = spatial_tangent::<2>(&d_alg, &dlog(&lam, &q), &b, &sigma, j);
+        let fast = spatial_tangent_eigen::<2>(&d_alg, &lam, &q, &sigma, j);
         assert!((literal - fast).amax() < 1e-10 * literal.amax(), "case {case}");
     }
 }

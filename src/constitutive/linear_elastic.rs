@@ -68,8 +68,11 @@ impl ConstitutiveModel for LinearElastic {
         Ok(MaterialResponse {
             tau,
             eps_e: *eps_trial,
-            d_alg: self.d,
             plastic_multiplier: committed.plastic_multiplier,
         })
+    }
+
+    fn tangent(&self, _eps_trial: &Matrix3<f64>, _committed: &MaterialState) -> Tensor4 {
+        self.d
     }
 }

@@ -76,7 +76,6 @@ impl ConstitutiveModel for VonMises {
             return Ok(MaterialResponse {
                 tau: s_trial + Matrix3::identity() * p,
                 eps_e: *eps_trial,
-                d_alg: self.d_elastic,
                 plastic_multiplier: committed.plastic_multiplier,
             });
         }
@@ -84,9 +83,6 @@ impl ConstitutiveModel for VonMises {
         let ratio = self.yield_stress / rho_trial;
         let s = s_trial * ratio;
         let eps_e = eps_trial - s_trial * (1.5 * dgamma / rho_trial);
-        let n = s_trial / norm_s;
-        let i_dev = identity_sym() - identity_outer() * (1.0 / 3.0);
-        let d_alg = identity_outer() * k + (i_dev - outer(&n, &n)) * (2.0 * g * ratio);
         if !eps_e.iter().all(|v| v.is_finite()) {
             return Err(MaterialError(
                 "von Mises return map produced a non-finite strain".into(),
@@ -95,8 +91,21 @@ impl ConstitutiveModel for VonMises {
         Ok(MaterialResponse {
             tau: s + Matrix3::identity() * p,
             eps_e,
-            d_alg,
             plastic_multiplier: committed.plastic_multiplier + dgamma,
         })
+    }
+
+    fn tangent(&self, eps_trial: &Matrix3<f64>, _committed: &MaterialState) -> Tensor4 {
+        let (k, g) = (self.bulk, self.shear);
+        let s_trial = deviator(eps_trial) * (2.0 * g);
+        let norm_s = s_trial.norm();
+        let rho_trial = (1.5f64).sqrt() * norm_s;
+        if rho_trial <= self.yield_stress {
+            return self.d_elastic;
+        }
+        let ratio = self.yield_stress / rho_trial;
+        let n = s_trial / norm_s;
+        let i_dev = identity_sym() - identity_outer() * (1.0 / 3.0);
+        identity_outer() * k + (i_dev - outer(&n, &n)) * (2.0 * g * ratio)
     }
 }

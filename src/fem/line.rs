@@ -1,6 +1,9 @@
 //! One-dimensional Lagrange line elements and meshes of them.
 
-use crate::error::InputError;
+use super::updated_lagrangian::FemMesh;
+use crate::assembly::SupportTable;
+use crate::error::{InputError, StepFailure};
+use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
 /// Most nodes of a line element.
@@ -157,5 +160,46 @@ impl LineMesh {
             *xk = self.nodes[a + k];
         }
         x
+    }
+}
+
+impl FemMesh<1> for LineMesh {
+    type Local = f64;
+
+    fn num_nodes(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// N_a(ξ_q) and ∂N_a/∂X̃ = (dX̃/dξ)⁻¹ dN_a/dξ on the current mesh (eqs 33–34).
+    fn fill_supports(
+        &self,
+        elements: &[usize],
+        xis: &[f64],
+        table: &mut SupportTable<1>,
+    ) -> Result<(), StepFailure> {
+        let element = self.element;
+        let k = element.nodes_per_element();
+        table.clear();
+        for (p, (&e, &xi)) in elements.iter().zip(xis).enumerate() {
+            let x = self.element_coordinates(e);
+            let (n, dn) = element.shape(xi);
+            let (_, jac) = element.map(&x[..k], xi);
+            if !(jac > 0.0 && jac.is_finite()) {
+                return Err(StepFailure::Kinematics {
+                    point: p,
+                    reason: format!("element {e} has dX/dξ = {jac:e} <= 0 at its Gauss point"),
+                });
+            }
+            let first = self.first_node(e);
+            for a in 0..k {
+                table.push_node(first + a, n[a], SVector::<f64, 1>::new(dn[a] / jac));
+            }
+            table.finish_point();
+        }
+        Ok(())
+    }
+
+    fn move_nodes(&mut self, du: &[f64]) {
+        self.nodes.iter_mut().zip(du).for_each(|(x, d)| *x += d);
     }
 }

@@ -1,7 +1,13 @@
-//! Updated-Lagrangian finite element comparators (§5.1, Table 1, Figure 11).
+//! Updated-Lagrangian finite element comparators (§5.1 Table 1 and Figure 11; §5.2 Figure 17;
+//! §5.3 Figure 21).
 //!
-//! The entry point is [`LineFem`], a 1D solver on a [`LineMesh`] of linear or quadratic
-//! elements with a Gauss rule of 1 to 5 points. It shares everything below the load-step loop
+//! The entry points are [`LineFem`], a 1D solver on a [`LineMesh`] of linear or quadratic
+//! elements with a Gauss rule of 1 to 5 points, and [`PlaneFem`], a plane-strain solver on a
+//! [`PlaneMesh`] of 4-node or 8-node serendipity quadrilaterals ([`QuadElement`]) with an n×n
+//! Gauss rule (default 2×2 for Q4, 3×3 for Q8). Both implement
+//! [`LoadStepping`] through the same generic load step
+//! (`fem_step` over the [`FemMesh`] trait: a mesh supplies its shape functions and moves its
+//! nodes; Gauss point storage is [`GaussPoints`]). Each shares everything below the load-step loop
 //! with the material point solver ([`crate::mpm::MpmSolver`]): Gauss points are integration
 //! points like material points, so each load step fills a [`SupportTable`] with the element
 //! shape functions N_a(ξ_q) and their gradients ∂N_a/∂X̃ on the start-of-step mesh
@@ -41,17 +47,23 @@
 //! Gauss points the error is O(h²). The paper states both facts (§5.1); the tests pin them.
 
 mod line;
+mod plane;
+mod quad;
+mod updated_lagrangian;
 
 pub use line::{LineElement, LineMesh, MAX_LINE_NODES};
+pub use plane::{PlaneFem, PlaneFemSettings, PlaneLoads};
+pub use quad::{PlaneMesh, QuadElement, MAX_QUAD_NODES};
+pub use updated_lagrangian::{validate_stepping, FemMesh, GaussPoints, MAX_LOAD_STEPS};
 
-use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
+use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
-use crate::error::{require_count, require_finite, InputError, SolveError, StepFailure};
-use crate::kinematics::PointState;
+use crate::error::{require_finite, InputError, SolveError, StepFailure};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::problems::column::{ColumnOutcome, ColumnSpec, PointRecord};
 use crate::quadrature::GaussRule;
 use nalgebra::SVector;
+use updated_lagrangian::{fem_step, fem_step_system, UlCore};
 
 /// Settings of a [`LineFem`] analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -66,16 +78,7 @@ pub struct LineFemSettings {
 impl LineFemSettings {
     pub fn validate(&self) -> Result<(), InputError> {
         GaussRule::try_new(self.gauss_points)?;
-        self.newton.validate()?;
-        require_count("load_steps", self.load_steps, 1)?;
-        if self.load_steps > 1_000_000 {
-            return Err(InputError::new(
-                "load_steps",
-                self.load_steps,
-                "must be <= 1000000",
-            ));
-        }
-        Ok(())
+        validate_stepping(&self.newton, self.load_steps)
     }
 }
 
@@ -88,32 +91,6 @@ pub struct LineLoads {
     pub nodal_forces: Vec<(usize, f64)>,
 }
 
-/// The Gauss points of a [`LineFem`], element by element (point `p = e * n_q + q`).
-#[derive(Debug, Clone, Default)]
-pub struct GaussPoints {
-    /// Element of each point.
-    pub element: Vec<usize>,
-    /// Local coordinate ξ_q.
-    pub xi: Vec<f64>,
-    /// Initial position X(ξ_q).
-    pub position0: Vec<f64>,
-    /// Initial volume (length) w_q det(∂X/∂ξ)|₀.
-    pub volume0: Vec<f64>,
-    /// Mass ρ0 w_q det(∂X/∂ξ)|₀.
-    pub mass: Vec<f64>,
-    /// Committed F, volume and constitutive state.
-    pub state: Vec<PointState>,
-}
-
-impl GaussPoints {
-    pub fn len(&self) -> usize {
-        self.xi.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.xi.is_empty()
-    }
-}
-
 /// Implicit updated-Lagrangian FEM on a line mesh.
 pub struct LineFem {
     /// Initial mesh.
@@ -121,16 +98,12 @@ pub struct LineFem {
     /// Current mesh (nodes moved with the material).
     pub mesh: LineMesh,
     pub gauss: GaussPoints,
-    model: Box<dyn ConstitutiveModel>,
     /// Nodes with zero displacement.
     pub fixed: Vec<usize>,
     pub loads: LineLoads,
     pub settings: LineFemSettings,
     rule: GaussRule,
-    step: usize,
-    /// Nodal dofs fixed at zero, as (node, axis).
-    fixed_dofs: Vec<(usize, usize)>,
-    work: StepWorkspace<1>,
+    core: UlCore<1>,
 }
 
 impl LineFem {
@@ -171,27 +144,19 @@ impl LineFem {
             let x = mesh.element_coordinates(e);
             for (&xi, &w) in rule.points().iter().zip(rule.weights()) {
                 let (pos, jac) = mesh.element.map(&x[..k], xi);
-                let v0 = w * jac;
-                gauss.element.push(e);
-                gauss.xi.push(xi);
-                gauss.position0.push(pos);
-                gauss.volume0.push(v0);
-                gauss.mass.push(density * v0);
-                gauss.state.push(PointState::undeformed(v0));
+                gauss.push(e, xi, pos, w * jac, density);
             }
         }
+        let fixed_dofs = fixed.iter().map(|&n| (n, 0)).collect();
         Ok(Self {
             mesh0: mesh.clone(),
             mesh,
             gauss,
-            model,
-            fixed: fixed.clone(),
+            fixed,
             loads,
             settings,
             rule,
-            step: 0,
-            fixed_dofs: fixed.iter().map(|&n| (n, 0)).collect(),
-            work: StepWorkspace::default(),
+            core: UlCore::new(model, fixed_dofs),
         })
     }
 
@@ -203,34 +168,13 @@ impl LineFem {
     /// Fill the support table: for each Gauss point its element's nodes, N_a(ξ_q) and
     /// ∂N_a/∂X̃ = (dX̃/dξ)⁻¹ dN_a/dξ on the current mesh (eqs 33–34).
     pub fn build_supports(&mut self) -> Result<(), StepFailure> {
-        let element = self.mesh.element;
-        let k = element.nodes_per_element();
-        self.work.table.clear();
-        for p in 0..self.gauss.len() {
-            let e = self.gauss.element[p];
-            let x = self.mesh.element_coordinates(e);
-            let (n, dn) = element.shape(self.gauss.xi[p]);
-            let (_, jac) = element.map(&x[..k], self.gauss.xi[p]);
-            if !(jac > 0.0 && jac.is_finite()) {
-                return Err(StepFailure::Kinematics {
-                    point: p,
-                    reason: format!("element {e} has dX/dξ = {jac:e} <= 0 at its Gauss point"),
-                });
-            }
-            let first = self.mesh.first_node(e);
-            for a in 0..k {
-                self.work
-                    .table
-                    .push_node(first + a, n[a], SVector::<f64, 1>::new(dn[a] / jac));
-            }
-            self.work.table.finish_point();
-        }
-        Ok(())
+        self.mesh
+            .fill_supports(&self.gauss.element, &self.gauss.xi, &mut self.core.work.table)
     }
 
     /// Supports of the last [`Self::build_supports`].
     pub fn supports(&self) -> &SupportTable<1> {
-        &self.work.table
+        &self.core.work.table
     }
 
     /// Set up the nonlinear system of a load step at `load_factor` on the current mesh and
@@ -241,39 +185,16 @@ impl LineFem {
         load_factor: f64,
         f: impl FnOnce(&mut LoadStepSystem<'_, 1>) -> R,
     ) -> Result<R, StepFailure> {
-        self.build_supports()?;
-        let forces: Vec<SVector<f64, 1>> = self
-            .gauss
-            .mass
-            .iter()
-            .map(|&m| SVector::<f64, 1>::new(m * self.loads.gravity * load_factor))
-            .collect();
-        let nodal: Vec<(usize, f64)> = self
-            .loads
-            .nodal_forces
-            .iter()
-            .map(|&(n, force)| (n, force * load_factor))
-            .collect();
-        let input = StepInput {
-            model: self.model.as_ref(),
-            states: &self.gauss.state,
-            num_nodes: self.mesh.num_nodes(),
-            fixed: &self.fixed_dofs,
-            ties: &[],
-            point_forces: &forces,
-            nodal_forces: &nodal,
-        };
-        Ok(self.work.with_system(&input, f))
-    }
-
-    /// Commit the converged step: Gauss point states and node positions x = X̃ + Δu.
-    fn commit(&mut self) {
-        for (state, new) in self.gauss.state.iter_mut().zip(self.work.committed_states()) {
-            *state = new;
-        }
-        for (x, du) in self.mesh.nodes.iter_mut().zip(&self.work.du_nodal) {
-            *x += du;
-        }
+        let gravity = SVector::<f64, 1>::new(self.loads.gravity);
+        fem_step_system(
+            &mut self.core,
+            &self.mesh,
+            &self.gauss,
+            gravity,
+            &self.loads.nodal_forces,
+            load_factor,
+            f,
+        )
     }
 
     /// Current position x(ξ_q) and Jacobian dx/dξ of Gauss point `p` on the current mesh.
@@ -291,32 +212,18 @@ impl LineFem {
 
 impl LoadStepping for LineFem {
     fn step(&mut self) -> Result<StepReport, SolveError> {
-        let step = self.step + 1;
-        let fail = |failure, residuals| SolveError {
-            step,
-            failure,
-            residuals,
-        };
-        let load_factor = step as f64 / self.settings.load_steps as f64;
-        let newton_settings = self.settings.newton;
-        let report = self
-            .with_step_system(load_factor, |system| {
-                let mut u = vec![0.0; crate::newton::NonlinearSystem::num_unknowns(system)];
-                crate::newton::solve(system, &mut u, &newton_settings)
-            })
-            .map_err(|f| fail(f, vec![]))?
-            .map_err(|(f, r)| fail(f, r))?;
-        self.commit();
-        self.step = step;
-        Ok(StepReport {
-            step,
-            load_factor,
-            newton: report,
-            weak_nodes: 0,
-        })
+        fem_step(
+            &mut self.core,
+            &mut self.mesh,
+            &mut self.gauss,
+            SVector::<f64, 1>::new(self.loads.gravity),
+            &self.loads.nodal_forces,
+            &self.settings.newton,
+            self.settings.load_steps,
+        )
     }
     fn steps_done(&self) -> usize {
-        self.step
+        self.core.step
     }
     fn load_steps(&self) -> usize {
         self.settings.load_steps

@@ -168,6 +168,7 @@ impl CantileverSpec {
             weak_node_tolerance: self.weak_node_tolerance,
             weak_node_treatment: self.weak_node_treatment,
             volume_update: self.volume_update,
+            linear_solver: Default::default(),
         };
         let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
         Ok((

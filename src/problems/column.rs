@@ -400,6 +400,7 @@ impl ColumnSpec {
             weak_node_tolerance: 0.0,
             weak_node_treatment: Default::default(),
             volume_update: Default::default(),
+            linear_solver: Default::default(),
         };
         MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, settings)
     }
@@ -434,13 +435,15 @@ pub fn yield_height_estimate(points: &[PointRecord], yield_stress: f64) -> Optio
     let mut elastic: Vec<&PointRecord> = points.iter().filter(|p| p.plastic_multiplier == 0.0).collect();
     elastic.sort_by(|a, b| a.z0.total_cmp(&b.z0));
     let rho = |p: &PointRecord| ((p.sigma_xx - p.sigma_zz) * p.f_zz).abs();
-    match elastic.as_slice() {
-        [a, b, ..] => {
-            let (ra, rb) = (rho(a), rho(b));
-            Some(a.z0 + (yield_stress - ra) * (b.z0 - a.z0) / (rb - ra))
-        }
-        _ => None,
-    }
+    // Extrapolate from the lowest elastic point and the next one with a different ρ (linear
+    // elements have equal stresses at both Gauss points of an element).
+    let a = *elastic.first()?;
+    let ra = rho(a);
+    let b = elastic[1..]
+        .iter()
+        .find(|p| (rho(p) - ra).abs() > 1e-12 * ra.abs().max(1.0))?;
+    let z = a.z0 + (yield_stress - ra) * (b.z0 - a.z0) / (rho(b) - ra);
+    z.is_finite().then_some(z)
 }
 
 /// Outcome of one column analysis.
@@ -458,6 +461,11 @@ pub struct ColumnOutcome {
     pub stress_error: f64,
     /// Eq (47) against the exact analytical base value.
     pub f_error: f64,
+    /// Eq (46) applied to the lateral stress σ_xx (plastic column, §5.1).
+    pub sigma_xx_error: f64,
+    /// Yield height seen by the discretisation ([`yield_height_estimate`]); `None` when
+    /// elastic or when no point yielded.
+    pub yield_height: Option<f64>,
 }
 
 impl ColumnOutcome {
@@ -480,6 +488,12 @@ impl ColumnOutcome {
             .min_by(|a, b| a.z0.total_cmp(&b.z0))
             .map_or(f64::NAN, |p| p.f_zz);
         let f_error = norms::f_error(base, exact.deformation_gradient(0.0));
+        let sxx_exact: Vec<f64> = points.iter().map(|p| exact.lateral_stress(p.z0)).collect();
+        let sxx_h: Vec<f64> = points.iter().map(|p| p.sigma_xx).collect();
+        let sigma_xx_error = norms::stress_error(&sxx_exact, &sxx_h, &v0, spec.weight, spec.length);
+        let yield_height = spec
+            .yield_stress
+            .and_then(|ry| yield_height_estimate(&points, ry));
         Self {
             points,
             steps,
@@ -488,6 +502,8 @@ impl ColumnOutcome {
             base_f: base,
             stress_error,
             f_error,
+            sigma_xx_error,
+            yield_height,
         }
     }
 }

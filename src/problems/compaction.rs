@@ -11,6 +11,7 @@ use crate::basis::Basis;
 use crate::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::grid::Grid;
+use crate::linear::LinearSolver;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, WeakNodeTreatment};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::particles::MaterialPoints;
@@ -45,6 +46,9 @@ pub struct CompactionSpec {
     pub weak_node_treatment: WeakNodeTreatment,
     pub basis: Basis,
     pub domain_update: DomainUpdate,
+    /// Sparse factorisation; LDLᵀ suits this symmetric tangent (LU fallback).
+    #[serde(default)]
+    pub linear_solver: LinearSolver,
 }
 
 impl Default for CompactionSpec {
@@ -65,6 +69,7 @@ impl Default for CompactionSpec {
             weak_node_treatment: WeakNodeTreatment::Tie,
             basis: Basis::Gimp,
             domain_update: DomainUpdate::Stretch,
+            linear_solver: LinearSolver::Lu,
         }
     }
 }
@@ -157,6 +162,7 @@ impl CompactionSpec {
             weak_node_tolerance: self.weak_node_tolerance,
             weak_node_treatment: self.weak_node_treatment,
             volume_update: Default::default(),
+            linear_solver: self.linear_solver,
         };
         MpmSolver::try_new(grid, points, self.model()?, fixed, loads, settings)
     }

@@ -68,13 +68,33 @@ pub enum Measure {
     StressError,
     /// Relative error of F at the base, eq (47).
     FError,
+    /// Eq (46) applied to the lateral stress σ_xx (plastic column).
+    SigmaXxError,
+    /// |Z_y,h − Z_y| / L0: yield height seen by the points against the analytical one.
+    YieldHeightError,
 }
 
 impl Measure {
+    /// The measures a study reports: the plastic ones only when it has a yield stress.
+    pub fn all(plastic: bool) -> &'static [Measure] {
+        if plastic {
+            &[
+                Measure::StressError,
+                Measure::FError,
+                Measure::SigmaXxError,
+                Measure::YieldHeightError,
+            ]
+        } else {
+            &[Measure::StressError, Measure::FError]
+        }
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Measure::StressError => "stress_error",
             Measure::FError => "f_error",
+            Measure::SigmaXxError => "sigma_xx_error",
+            Measure::YieldHeightError => "yield_height_error",
         }
     }
     /// Axis / table label.
@@ -82,6 +102,8 @@ impl Measure {
         match self {
             Measure::StressError => "stress error, eq (46)",
             Measure::FError => "base F error, eq (47)",
+            Measure::SigmaXxError => "σxx error, eq (46) on σxx",
+            Measure::YieldHeightError => "yield height error |Zy,h − Zy| / L0",
         }
     }
 }
@@ -108,6 +130,9 @@ pub struct ColumnSection {
     pub poisson_ratio: f64,
     /// Initial density ρ0 (kg/m³).
     pub density: f64,
+    /// Von Mises yield stress ρ_y (Pa), eq (48); absent for the elastic column.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yield_stress: Option<f64>,
 }
 
 /// Newton settings as written in a study file.
@@ -424,6 +449,9 @@ impl StudySpec {
             return Err(c.err("column.poisson_ratio", col.poisson_ratio, "must lie in [0, 0.5)"));
         }
         c.positive("column.density", col.density)?;
+        if let Some(ry) = col.yield_stress {
+            c.positive("column.yield_stress", ry)?;
+        }
         c.count("load_steps", self.load_steps, 1, 10_000)?;
         c.newton("newton", &self.newton)?;
         c.non_empty("sweeps", &self.sweeps)?;
@@ -696,6 +724,7 @@ impl StudySpec {
             young_modulus: self.column.young_modulus,
             poisson_ratio: self.column.poisson_ratio,
             density: self.column.density,
+            yield_stress: self.column.yield_stress,
             weight,
             elements,
             points_per_cell: ppc,

@@ -61,6 +61,8 @@ pub fn case_error(case: &CaseRecord, measure: Measure) -> Option<f64> {
     let e = match measure {
         Measure::StressError => case.stress_error,
         Measure::FError => case.f_error,
+        Measure::SigmaXxError => case.sigma_xx_error,
+        Measure::YieldHeightError => case.yield_height_error,
     }?;
     (e.is_finite() && e > 0.0).then_some(e)
 }
@@ -122,7 +124,7 @@ pub fn compute_rates(
             for &load in &plan.weights {
                 for &ppc in &ppcs {
                     let s = series(cases, ids, method, load, ppc);
-                    for measure in [Measure::StressError, Measure::FError] {
+                    for &measure in Measure::all(spec.column.yield_stress.is_some()) {
                         let pts: Vec<(usize, f64)> = s
                             .iter()
                             .filter_map(|c| case_error(c, measure).map(|e| (c.elements, e)))

@@ -20,6 +20,8 @@ use std::time::Instant;
 
 /// Header of the per-case point files.
 pub const POINTS_HEADER: &str = "z0,z,volume0,sigma_zz,f_zz";
+/// Header of the per-case point files of plastic studies (adds the lateral stress).
+pub const POINTS_HEADER_PLASTIC: &str = "z0,z,volume0,sigma_zz,f_zz,sigma_xx";
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -69,6 +71,15 @@ pub struct CaseRecord {
     pub stress_error: Option<f64>,
     /// Eq (47) against the exact analytical base F, converged cases only.
     pub f_error: Option<f64>,
+    /// Eq (46) on σ_xx (plastic studies only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sigma_xx_error: Option<f64>,
+    /// Yield height seen by the points (plastic studies only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yield_height: Option<f64>,
+    /// |yield_height − analytical| / L0 (plastic studies only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yield_height_error: Option<f64>,
     pub top_displacement: Option<f64>,
     pub base_f: Option<f64>,
     /// Number of material or Gauss points (rows of the point file).
@@ -171,6 +182,9 @@ pub fn run_case(case: &Case) -> (CaseRecord, Vec<PointRecord>) {
         failure: None,
         stress_error: None,
         f_error: None,
+        sigma_xx_error: None,
+        yield_height: None,
+        yield_height_error: None,
         top_displacement: None,
         base_f: None,
         points: 0,
@@ -212,6 +226,16 @@ pub fn run_case(case: &Case) -> (CaseRecord, Vec<PointRecord>) {
                     rec.status = CaseStatus::Converged;
                     rec.stress_error = finite(out.stress_error);
                     rec.f_error = finite(out.f_error);
+                    if let Some(ry) = case.spec.yield_stress {
+                        let _ = ry;
+                        rec.sigma_xx_error = finite(out.sigma_xx_error);
+                        rec.yield_height = out.yield_height;
+                        let exact = case.spec.analytical().yield_height();
+                        rec.yield_height_error = match (out.yield_height, exact) {
+                            (Some(h), Some(e)) => finite((h - e).abs() / case.spec.length),
+                            _ => None,
+                        };
+                    }
                     rec.top_displacement = finite(out.top_displacement);
                     rec.base_f = finite(out.base_f);
                 }
@@ -284,32 +308,54 @@ pub fn points_file(case_id: &str) -> String {
 }
 
 /// One row per point, shortest round-trip formatting (so the file re-reads exactly).
-pub fn points_csv(points: &[PointRecord]) -> String {
-    let mut s = String::with_capacity(64 * (points.len() + 1));
-    s.push_str(POINTS_HEADER);
+pub fn points_csv(points: &[PointRecord], plastic: bool) -> String {
+    let mut s = String::with_capacity(80 * (points.len() + 1));
+    s.push_str(if plastic {
+        POINTS_HEADER_PLASTIC
+    } else {
+        POINTS_HEADER
+    });
     s.push('\n');
     for p in points {
         s.push_str(&format!(
-            "{},{},{},{},{}\n",
+            "{},{},{},{},{}",
             p.z0, p.z, p.volume0, p.sigma_zz, p.f_zz
         ));
+        if plastic {
+            s.push_str(&format!(",{}", p.sigma_xx));
+        }
+        s.push('\n');
     }
     s
 }
 
-/// Parse a points file written by [`points_csv`]: rows of (z0, z, volume0, sigma_zz, f_zz).
-pub fn read_points_csv(path: &Path) -> Result<Vec<[f64; 5]>, StudyError> {
+/// Parse a points file written by [`points_csv`]: rows of (z0, z, volume0, sigma_zz, f_zz)
+/// and, in plastic studies, sigma_xx.
+pub fn read_points_csv(path: &Path) -> Result<Vec<Vec<f64>>, StudyError> {
     let text = std::fs::read_to_string(path).map_err(|e| StudyError::io(path, e))?;
     let mut lines = text.lines();
-    if lines.next() != Some(POINTS_HEADER) {
-        return Err(StudyError::io(path, format!("header must be `{POINTS_HEADER}`")));
-    }
+    let width = match lines.next() {
+        Some(POINTS_HEADER) => 5,
+        Some(POINTS_HEADER_PLASTIC) => 6,
+        _ => {
+            return Err(StudyError::io(
+                path,
+                format!("header must be `{POINTS_HEADER}` or `{POINTS_HEADER_PLASTIC}`"),
+            ))
+        }
+    };
     lines
         .enumerate()
         .map(|(i, l)| {
             let v: Vec<f64> = l.split(',').filter_map(|x| x.parse().ok()).collect();
-            <[f64; 5]>::try_from(v)
-                .map_err(|_| StudyError::io(path, format!("line {}: expected 5 numbers", i + 2)))
+            if v.len() == width {
+                Ok(v)
+            } else {
+                Err(StudyError::io(
+                    path,
+                    format!("line {}: expected {width} numbers", i + 2),
+                ))
+            }
         })
         .collect()
 }
@@ -330,7 +376,8 @@ pub fn write_outputs(out: &Path, run: &StudyRun) -> Result<PathBuf, StudyError> 
             continue;
         }
         let p = dir.join(points_file(&case.id));
-        std::fs::write(&p, points_csv(pts)).map_err(|e| StudyError::io(&p, e))?;
+        let plastic = run.results.study.column.yield_stress.is_some();
+        std::fs::write(&p, points_csv(pts, plastic)).map_err(|e| StudyError::io(&p, e))?;
     }
     let json = serde_json::to_string_pretty(&run.results).map_err(|e| StudyError::io(&dir, e))?;
     let p = dir.join("results.json");

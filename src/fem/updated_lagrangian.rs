@@ -1,0 +1,253 @@
+//! What the updated-Lagrangian FEM solvers share whatever their element: Gauss point storage,
+//! the validation of load-step settings, and one load step (loads scaled by the load factor,
+//! Newton on the shared [`StepWorkspace`], commit of the Gauss point states and of the node
+//! positions). A solver adds only its shape functions: it fills the [`SupportTable`] with
+//! N_a(ξ_q) and ∂N_a/∂X̃ on the start-of-step mesh and moves its nodes by the increment.
+
+use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
+use crate::constitutive::ConstitutiveModel;
+use crate::error::{require_count, InputError, SolveError, StepFailure};
+use crate::kinematics::PointState;
+use crate::newton::{NewtonSettings, StepReport};
+use nalgebra::SVector;
+
+/// Most load steps an analysis may ask for.
+pub const MAX_LOAD_STEPS: usize = 1_000_000;
+
+/// Check the Newton settings and the number of load steps (1..=[`MAX_LOAD_STEPS`]).
+pub fn validate_stepping(newton: &NewtonSettings, load_steps: usize) -> Result<(), InputError> {
+    newton.validate()?;
+    require_count("load_steps", load_steps, 1)?;
+    if load_steps > MAX_LOAD_STEPS {
+        return Err(InputError::new(
+            "load_steps",
+            load_steps,
+            format!("must be <= {MAX_LOAD_STEPS}"),
+        ));
+    }
+    Ok(())
+}
+
+/// The Gauss points of a FEM solver, element by element (point `p = e * n_q + q`). `X` is
+/// the type of a local coordinate and of a position: `f64` for line elements,
+/// `SVector<f64, 2>` for plane elements.
+#[derive(Debug, Clone, Default)]
+pub struct GaussPoints<X = f64> {
+    /// Element of each point.
+    pub element: Vec<usize>,
+    /// Local coordinate ξ_q.
+    pub xi: Vec<X>,
+    /// Initial position X(ξ_q).
+    pub position0: Vec<X>,
+    /// Initial volume w_q det(∂X/∂ξ)|₀ (a length in 1D, an area per unit thickness in 2D).
+    pub volume0: Vec<f64>,
+    /// Mass ρ0 w_q det(∂X/∂ξ)|₀.
+    pub mass: Vec<f64>,
+    /// Committed F, volume and constitutive state.
+    pub state: Vec<PointState>,
+}
+
+impl<X> GaussPoints<X> {
+    pub fn len(&self) -> usize {
+        self.xi.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.xi.is_empty()
+    }
+    /// Append an undeformed point of element `e` at ξ with initial position and volume.
+    pub fn push(&mut self, e: usize, xi: X, position0: X, volume0: f64, density: f64) {
+        self.element.push(e);
+        self.xi.push(xi);
+        self.position0.push(position0);
+        self.volume0.push(volume0);
+        self.mass.push(density * volume0);
+        self.state.push(PointState::undeformed(volume0));
+    }
+    /// Reserve room for `n` more points.
+    pub fn reserve(&mut self, n: usize) {
+        self.element.reserve(n);
+        self.xi.reserve(n);
+        self.position0.reserve(n);
+        self.volume0.reserve(n);
+        self.mass.reserve(n);
+        self.state.reserve(n);
+    }
+}
+
+/// Loads at the end of the analysis in the form one step needs: gravity (body force per unit
+/// mass) carried by the Gauss point masses, and forces on nodal dofs (dof = node·D + axis).
+pub(crate) struct FullLoads<'a, const D: usize> {
+    pub gravity: SVector<f64, D>,
+    pub mass: &'a [f64],
+    pub dof_forces: &'a [(usize, f64)],
+}
+
+/// The load-step state of a FEM solver: model, Dirichlet dofs, steps done and the per-step
+/// workspace.
+pub(crate) struct UlCore<const D: usize> {
+    pub model: Box<dyn ConstitutiveModel>,
+    /// Nodal dofs fixed at zero, as (node, axis).
+    pub fixed_dofs: Vec<(usize, usize)>,
+    pub step: usize,
+    pub work: StepWorkspace<D>,
+}
+
+impl<const D: usize> UlCore<D> {
+    pub fn new(model: Box<dyn ConstitutiveModel>, fixed_dofs: Vec<(usize, usize)>) -> Self {
+        Self {
+            model,
+            fixed_dofs,
+            step: 0,
+            work: StepWorkspace::default(),
+        }
+    }
+
+    /// Build the [`StepInput`] at `load_factor` (the supports must be in `work.table`) and
+    /// hand it with the workspace to `f`.
+    pub fn with_input<R>(
+        &mut self,
+        states: &[PointState],
+        num_nodes: usize,
+        loads: &FullLoads<'_, D>,
+        load_factor: f64,
+        f: impl FnOnce(&mut StepWorkspace<D>, &StepInput<'_, D>) -> R,
+    ) -> R {
+        // Dead loads: gravity m_q g mapped with N (eq 40) and nodal forces, both ∝ load factor.
+        let forces: Vec<SVector<f64, D>> = loads
+            .mass
+            .iter()
+            .map(|&m| loads.gravity * (m * load_factor))
+            .collect();
+        let nodal: Vec<(usize, f64)> = loads
+            .dof_forces
+            .iter()
+            .map(|&(dof, force)| (dof, force * load_factor))
+            .collect();
+        let input = StepInput {
+            model: self.model.as_ref(),
+            states,
+            num_nodes,
+            fixed: &self.fixed_dofs,
+            ties: &[],
+            point_forces: &forces,
+            nodal_forces: &nodal,
+        };
+        f(&mut self.work, &input)
+    }
+
+    /// Solve and commit load step `step + 1` of `load_steps` at load factor step/load_steps
+    /// (the ramp of the material point solver). `build_supports` fills the support table on
+    /// the start-of-step mesh; on convergence the Gauss point states are committed, and the
+    /// caller moves its nodes by the converged increment `work.du_nodal` (node·D + axis).
+    pub fn step(
+        &mut self,
+        newton: &NewtonSettings,
+        load_steps: usize,
+        states: &mut [PointState],
+        num_nodes: usize,
+        loads: &FullLoads<'_, D>,
+        build_supports: impl FnOnce(&mut SupportTable<D>) -> Result<(), StepFailure>,
+    ) -> Result<StepReport, SolveError> {
+        let step = self.step + 1;
+        let fail = |failure, residuals| SolveError {
+            step,
+            failure,
+            residuals,
+        };
+        let load_factor = step as f64 / load_steps as f64;
+        build_supports(&mut self.work.table).map_err(|f| fail(f, vec![]))?;
+        let report = self
+            .with_input(states, num_nodes, loads, load_factor, |work, input| {
+                work.solve(input, newton)
+            })
+            .map_err(|(f, r)| fail(f, r))?;
+        for (state, new) in states.iter_mut().zip(self.work.committed_states()) {
+            *state = new;
+        }
+        self.step = step;
+        Ok(StepReport {
+            step,
+            load_factor,
+            newton: report,
+            weak_nodes: 0,
+        })
+    }
+}
+
+/// A finite element mesh as the load-step machinery sees it: nodes that move with the material
+/// and shape functions evaluated at Gauss points on the current configuration.
+pub trait FemMesh<const D: usize> {
+    /// Local coordinate of a Gauss point in its element.
+    type Local;
+    fn num_nodes(&self) -> usize;
+    /// Fill `table` with, for each Gauss point (element `elements[p]`, local coordinate
+    /// `xis[p]`), its element's nodes, N_a(ξ_q) and ∂N_a/∂X̃ on the current mesh (eqs 33–34).
+    /// Fails if an element is inverted at a Gauss point.
+    fn fill_supports(
+        &self,
+        elements: &[usize],
+        xis: &[Self::Local],
+        table: &mut SupportTable<D>,
+    ) -> Result<(), StepFailure>;
+    /// Move the nodes by a nodal increment (dof = node·D + axis).
+    fn move_nodes(&mut self, du: &[f64]);
+}
+
+/// One load step of an updated-Lagrangian FEM solver on `mesh` (the shared body of
+/// `LoadStepping::step`): supports on the start-of-step mesh, Newton, commit of the Gauss
+/// point states, and the nodes moved by the converged increment, which makes the converged
+/// configuration the next reference.
+pub(crate) fn fem_step<const D: usize, M: FemMesh<D>>(
+    core: &mut UlCore<D>,
+    mesh: &mut M,
+    gauss: &mut GaussPoints<M::Local>,
+    gravity: SVector<f64, D>,
+    dof_forces: &[(usize, f64)],
+    newton: &NewtonSettings,
+    load_steps: usize,
+) -> Result<StepReport, SolveError> {
+    let loads = FullLoads {
+        gravity,
+        mass: &gauss.mass,
+        dof_forces,
+    };
+    let (elements, xis) = (&gauss.element, &gauss.xi);
+    let m: &M = mesh;
+    let report = core.step(
+        newton,
+        load_steps,
+        &mut gauss.state,
+        m.num_nodes(),
+        &loads,
+        |table| m.fill_supports(elements, xis, table),
+    )?;
+    mesh.move_nodes(&core.work.du_nodal);
+    Ok(report)
+}
+
+/// The nonlinear system of a load step at `load_factor` on the current mesh and committed
+/// states (supports, dof map, sparsity pattern, external force), handed to `f`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn fem_step_system<const D: usize, M: FemMesh<D>, R>(
+    core: &mut UlCore<D>,
+    mesh: &M,
+    gauss: &GaussPoints<M::Local>,
+    gravity: SVector<f64, D>,
+    dof_forces: &[(usize, f64)],
+    load_factor: f64,
+    f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
+) -> Result<R, StepFailure> {
+    mesh.fill_supports(&gauss.element, &gauss.xi, &mut core.work.table)?;
+    let loads = FullLoads {
+        gravity,
+        mass: &gauss.mass,
+        dof_forces,
+    };
+    Ok(core.with_input(
+        &gauss.state,
+        mesh.num_nodes(),
+        &loads,
+        load_factor,
+        |work, input| work.with_system(input, f),
+    ))
+}
