@@ -3,21 +3,27 @@
 //!
 //! A sweep is methods × element sizes × points per cell × weak-node tolerances for one
 //! material (elastic, or von Mises when `yield_stress` is set). Figure 17 normalises the
-//! maximum horizontal displacement by a reference: the converged Q4 FEM value once the 2D FEM
-//! comparator exists (Richardson-extrapolated over its finest three meshes when they allow
-//! it), and until then the finest iGIMP case of the reference sweep (smallest element size,
-//! most points per cell), which the report and captions state.
+//! maximum horizontal displacement by a reference: the converged Q4 FEM value of the
+//! `reference.fem_sweep` (Richardson-extrapolated over its finest three meshes when they allow
+//! it, else its finest mesh), or, when no FEM case converged, the finest iGIMP case of the
+//! Figure 17 sweep (smallest element size, most points per cell), which the report and
+//! captions then state.
 
 use super::plane::{
     self, check_at_most, failure_record, invalid, rejection, step_records, CheckRecord, IndexEntry,
-    PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection, FEM_2D_UNAVAILABLE,
+    PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
 };
 use super::runner::{CaseStatus, FailureRecord, StepRecord};
 use super::{NewtonSection, StudyError, Tier};
 use crate::error::SolveError;
+use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads};
+use crate::fem::{PlaneMesh, QuadElement};
+use crate::linear::LinearSolver;
+use crate::newton::LoadStepping;
 use crate::newton::StepReport;
 use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, XyAxes, XySeries};
 use crate::problems::compaction::{solve_mpm, CompactionSpec, DomainRecord};
+use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -80,8 +86,13 @@ pub struct CompactionSweep {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceSection {
-    /// Sweep whose FEM cases (else finest iGIMP case) give the reference.
-    pub sweep: String,
+    /// Sweep whose FEM cases give the reference: Richardson-extrapolated over its three
+    /// finest meshes when they refine by a constant ratio and converge monotonically, else
+    /// its finest mesh.
+    pub fem_sweep: String,
+    /// The Figure 17 sweep; its finest iGIMP case is the fallback reference when no FEM case
+    /// converged.
+    pub igimp_sweep: String,
     pub source: String,
 }
 
@@ -190,6 +201,8 @@ pub struct CompactionStudy {
     pub figures: Vec<CompactionFigure>,
 }
 
+type V2 = SVector<f64, 2>;
+
 /// One case to solve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompactionCase {
@@ -287,7 +300,8 @@ impl PlaneStudy for CompactionStudy {
                 .find(|s| s.id == id)
                 .ok_or_else(|| invalid(file, key, id, "must name a sweep"))
         };
-        sweep_known("reference.sweep".into(), &self.reference.sweep)?;
+        sweep_known("reference.fem_sweep".into(), &self.reference.fem_sweep)?;
+        sweep_known("reference.igimp_sweep".into(), &self.reference.igimp_sweep)?;
         for (i, e) in self.expect_deviation.iter().enumerate() {
             sweep_known(format!("expect_deviation[{i}].sweep"), &e.sweep)?;
         }
@@ -559,10 +573,46 @@ struct CaseOutcome {
     domains: Vec<DomainRecord>,
 }
 
-/// Updated-Lagrangian Q4 FEM of the block with the same supports and gravity ramp: the
-/// Figure 17 reference. The 2D comparator is not on this branch yet, so the case is rejected.
-fn solve_fem_q4(_spec: &CompactionSpec) -> Result<CaseOutcome, String> {
-    Err(FEM_2D_UNAVAILABLE.to_string())
+/// Updated-Lagrangian Q4 FEM (2×2 Gauss points, LDLᵀ) of the modelled half block with the
+/// same supports, material and gravity ramp: the Figure 17 reference. The measure is the
+/// horizontal displacement of the bottom-right node.
+fn solve_fem_q4(spec: &CompactionSpec) -> Result<CaseOutcome, String> {
+    let h = spec.element_size;
+    let cells = (
+        (spec.half_width / h).round() as usize,
+        (spec.height / h).round() as usize,
+    );
+    let size = V2::new(spec.half_width, spec.height);
+    let mesh = PlaneMesh::rectangle(V2::zeros(), size, cells, QuadElement::Q4).map_err(|e| e.to_string())?;
+    let tol = 1e-9 * h;
+    let mut fixed: Vec<(usize, usize)> = mesh.nodes_at(0, 0.0, tol).into_iter().map(|n| (n, 0)).collect();
+    fixed.extend(mesh.nodes_at(1, 0.0, tol).into_iter().map(|n| (n, 1)));
+    let corner = mesh.nearest_node(V2::new(spec.half_width, 0.0));
+    let elements = mesh.num_elements();
+    let loads = PlaneLoads {
+        gravity: V2::new(0.0, -spec.unit_weight()),
+        nodal_forces: vec![],
+    };
+    let settings = PlaneFemSettings {
+        gauss_points: Some(2),
+        newton: spec.newton,
+        load_steps: spec.load_steps,
+        linear_solver: LinearSolver::Ldlt,
+    };
+    let model = spec.model().map_err(|e| e.to_string())?;
+    let mut fem = PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings).map_err(|e| e.to_string())?;
+    let (steps, failure) = match fem.run() {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    Ok(CaseOutcome {
+        steps,
+        failure,
+        max_horizontal_displacement: fem.displacement(corner)[0],
+        weak_nodes_treated: 0,
+        points: elements,
+        domains: vec![],
+    })
 }
 
 fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
@@ -637,10 +687,9 @@ pub fn richardson(values: [f64; 3], ratio: f64) -> Option<(f64, f64)> {
 }
 
 fn figure17_reference(results: &CompactionResults) -> Option<ReferenceRecord> {
-    let sweep = results.sweep(&results.study.reference.sweep);
-    let mut fem: Vec<&CompactionRecord> = sweep
-        .iter()
-        .copied()
+    let mut fem: Vec<&CompactionRecord> = results
+        .sweep(&results.study.reference.fem_sweep)
+        .into_iter()
         .filter(|c| c.method.is_fem() && c.max_horizontal_displacement.is_some())
         .collect();
     fem.sort_by(|a, b| b.h.total_cmp(&a.h));
@@ -676,8 +725,9 @@ fn figure17_reference(results: &CompactionResults) -> Option<ReferenceRecord> {
             description: format!("finest {} mesh, h = {}", finest.method.label(), finest.h),
         });
     }
-    let finest = sweep
-        .iter()
+    let finest = results
+        .sweep(&results.study.reference.igimp_sweep)
+        .into_iter()
         .filter(|c| c.method == PlaneMethod::Igimp && c.max_horizontal_displacement.is_some())
         .min_by(|a, b| {
             a.h.total_cmp(&b.h)
@@ -929,7 +979,7 @@ pub fn residual_table(results: &CompactionResults, p: &PaperResiduals) -> String
 }
 
 fn figure17_table(results: &CompactionResults) -> String {
-    let sweep_id = &results.study.reference.sweep;
+    let sweep_id = &results.study.reference.igimp_sweep;
     let cases = results.sweep(sweep_id);
     let mut hs: Vec<f64> = cases.iter().map(|c| c.h).collect();
     hs.sort_by(|a, b| b.total_cmp(a));

@@ -24,9 +24,6 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Reason recorded (status `rejected`) for FEM cases until the 2D finite element comparator is merged.
-pub const FEM_2D_UNAVAILABLE: &str = "2D FEM comparator not available";
-
 /// Method of a plane-strain case.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
