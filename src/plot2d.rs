@@ -279,6 +279,9 @@ impl LegendCorner {
 fn tick(v: f64, log: bool) -> String {
     if log {
         format!("{v:.0e}")
+    } else if v.abs() < 1e-12 {
+        // A tick at zero computed as a sum of steps (e.g. -1.1e-16).
+        "0".to_string()
     } else if v != 0.0 && (v.abs() < 1e-2 || v.abs() >= 1e5) {
         format!("{v:.1e}")
     } else {

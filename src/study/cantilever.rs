@@ -1145,7 +1145,7 @@ fn render_figure(
                 log_x: false,
                 log_y: false,
                 y_lines: vec![],
-                legend: LegendCorner::LowerLeft,
+                legend: LegendCorner::UpperRight,
             };
             xy_svg(&f.title, &axes, &series).map(Some).map_err(fail)
         }
