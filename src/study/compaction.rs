@@ -1259,7 +1259,13 @@ fn render_figure(
                 y_lines: vec![(0.99, "−1 %".into()), (1.01, "+1 %".into())],
                 legend: LegendCorner::LowerLeft,
             };
-            let title = format!("{} — u_ref: {}", f.title, reference.description);
+            // The full description is in the report; the title only names the reference.
+            let short = match (reference.method, reference.observed_order) {
+                (PlaneMethod::Igimp, _) => "finest iGIMP (no FEM)".to_string(),
+                (m, Some(_)) => format!("{}, extrapolated", m.label()),
+                (m, None) => format!("finest {}", m.label()),
+            };
+            let title = format!("{} (u_ref: {short})", f.title);
             xy_svg(&title, &axes, &series).map(Some).map_err(fail)
         }
     }
