@@ -48,6 +48,7 @@ pub mod newton;
 pub mod norms;
 pub mod particles;
 pub mod plot;
+pub mod plot2d;
 pub mod problems;
 pub mod quadrature;
 pub mod report;

@@ -9,12 +9,12 @@
 use plotters::prelude::*;
 
 /// Figure size in pixels.
-const SIZE: (u32, u32) = (900, 640);
-const FONT: &str = "sans-serif";
-const CAPTION_PT: u32 = 24;
-const AXIS_DESC_PT: u32 = 20;
-const TICK_PT: u32 = 16;
-const LEGEND_PT: u32 = 16;
+pub(crate) const SIZE: (u32, u32) = (900, 640);
+pub(crate) const FONT: &str = "sans-serif";
+pub(crate) const CAPTION_PT: u32 = 24;
+pub(crate) const AXIS_DESC_PT: u32 = 20;
+pub(crate) const TICK_PT: u32 = 16;
+pub(crate) const LEGEND_PT: u32 = 16;
 
 /// Series colours (colour-blind safe, Okabe–Ito).
 const PALETTE: [RGBColor; 7] = [
@@ -58,17 +58,22 @@ pub struct ConvergenceSeries {
     pub slope: Option<f64>,
 }
 
-type PlotResult<T> = Result<T, String>;
+pub(crate) type PlotResult<T> = Result<T, String>;
 
-fn err<E: std::fmt::Display>(e: E) -> String {
+pub(crate) fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
-fn color(i: usize) -> RGBColor {
+pub(crate) fn color(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
-fn draw_markers<'a, DB: DrawingBackend + 'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+pub(crate) fn draw_markers<
+    'a,
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
     points: &[(f64, f64)],
     marker: Marker,
@@ -135,7 +140,7 @@ fn draw_markers<'a, DB: DrawingBackend + 'a, X: Ranged<ValueType = f64>, Y: Rang
     Ok(())
 }
 
-fn padded(lo: f64, hi: f64, frac: f64) -> (f64, f64) {
+pub(crate) fn padded(lo: f64, hi: f64, frac: f64) -> (f64, f64) {
     let span = (hi - lo).abs().max(1e-12 * hi.abs().max(1.0));
     (lo - frac * span, hi + frac * span)
 }

@@ -10,7 +10,7 @@ use igimp::study::runner::{
     read_results, run_study_in, study_dir, write_outputs, CaseRecord, CaseStatus, RunOptions,
 };
 use igimp::study::vtk_output::VtkOptions;
-use igimp::study::{study_files, StudyError, StudySpec, Tier};
+use igimp::study::{plane, study_files, StudyError, StudySpec, Tier};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -72,7 +72,9 @@ fn catalogue(dir: &Path) -> Vec<Result<(String, String), StudyError>> {
     match study_files(dir) {
         Ok(files) => files
             .iter()
-            .map(|f| StudySpec::load(f).map(|s| (s.name, s.summary)))
+            .map(|f| {
+                plane::catalogue_entry(f).unwrap_or_else(|| StudySpec::load(f).map(|s| (s.name, s.summary)))
+            })
             .collect(),
         Err(e) => vec![Err(e)],
     }
@@ -119,7 +121,37 @@ fn progress(n: u64) -> ProgressBar {
     bar
 }
 
+/// Run a plane-strain study (compaction, cantilever); `None` if `file` is another study.
+fn run_plane(file: &Path, cli: &Cli) -> Result<Option<bool>, StudyError> {
+    let Ok(text) = std::fs::read_to_string(file) else {
+        return Ok(None);
+    };
+    let Some(problem) = plane::problem_of_study(&text).filter(|p| plane::is_plane_problem(p)) else {
+        return Ok(None);
+    };
+    let tier = if cli.quick { Tier::Quick } else { Tier::Full };
+    let start = Instant::now();
+    let (dir, summary, files) = plane::run_file(file, &text, &problem, tier, &cli.out, cli.render_only)?;
+    if let Some(r) = summary {
+        eprintln!(
+            "{problem}: {} cases ({} failed, {} rejected) solved and {} files rendered into {} in {:.2} s",
+            r.cases,
+            r.failed,
+            r.rejected,
+            files.len(),
+            dir.display(),
+            start.elapsed().as_secs_f64()
+        );
+    }
+    let (pass, fail, none) = plane::folder_check_counts(&dir)?;
+    eprintln!("{problem}: checks: {pass} passed, {fail} failed, {none} not evaluated");
+    Ok(Some(fail == 0 && none == 0))
+}
+
 fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
+    if let Some(ok) = run_plane(file, cli)? {
+        return Ok(ok);
+    }
     let spec = StudySpec::load(file)?;
     let dir = study_dir(&cli.out, &spec.name);
     if !cli.render_only {

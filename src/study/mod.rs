@@ -9,6 +9,9 @@
 //! Counts in the file are parsed as signed integers so that a negative value is reported by
 //! [`StudySpec::validate`] with its key and allowed range instead of as a type error.
 
+pub mod cantilever;
+pub mod compaction;
+pub mod plane;
 pub mod rates;
 pub mod runner;
 pub mod store;

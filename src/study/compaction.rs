@@ -1,0 +1,1321 @@
+//! The compaction study (§5.2): `studies/compaction.toml` → `results.json` → `report.md`,
+//! `table2.md`, `table3.md` and Figures 15–18.
+//!
+//! A sweep is methods × element sizes × points per cell × weak-node tolerances for one
+//! material (elastic, or von Mises when `yield_stress` is set). Figure 17 normalises the
+//! maximum horizontal displacement by a reference: the converged Q4 FEM value of the
+//! `reference.fem_sweep` (Richardson-extrapolated over its finest three meshes when they allow
+//! it, else its finest mesh), or, when no FEM case converged, the finest iGIMP case of the
+//! Figure 17 sweep (smallest element size, most points per cell), which the report and
+//! captions then state.
+
+use super::plane::{
+    self, check_at_most, failure_record, invalid, rejection, step_records, CheckRecord, IndexEntry,
+    PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
+};
+use super::runner::{CaseStatus, FailureRecord, StepRecord};
+use super::{NewtonSection, StudyError, Tier};
+use crate::error::SolveError;
+use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads};
+use crate::fem::{PlaneMesh, QuadElement};
+use crate::linear::LinearSolver;
+use crate::newton::LoadStepping;
+use crate::newton::StepReport;
+use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, XyAxes, XySeries};
+use crate::problems::compaction::{solve_mpm, CompactionSpec, DomainRecord};
+use nalgebra::SVector;
+use serde::{Deserialize, Serialize};
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Geometry, material and loading of the block (the paper's §5.2 values in the study file).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockSection {
+    /// Half width of the block, the modelled half (the full block is twice as wide).
+    pub half_width: f64,
+    pub height: f64,
+    /// Background grid extent along x and y from the symmetry line / base.
+    pub grid_extent: [f64; 2],
+    pub young_modulus: f64,
+    pub poisson_ratio: f64,
+    /// Weight w of the full block at the end of loading.
+    pub weight: f64,
+    /// Gravity is ramped linearly over this many load steps.
+    pub load_steps: i64,
+}
+
+/// Quick-tier overrides of a sweep.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepQuick {
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub skip: bool,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub methods: Option<Vec<PlaneMethod>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element_sizes: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points_per_cell: Option<Vec<i64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weak_node_tolerances: Option<Vec<f64>>,
+}
+
+/// Methods × element sizes × points per cell × weak-node tolerances, one material.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompactionSweep {
+    pub id: String,
+    pub title: String,
+    pub methods: Vec<PlaneMethod>,
+    /// Von Mises yield stress ρ_y; absent: linear elastic.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yield_stress: Option<f64>,
+    pub element_sizes: Vec<f64>,
+    /// Material points per element along each axis (iGIMP only).
+    pub points_per_cell: Vec<i64>,
+    /// Defaults to `[weak_nodes.tolerance]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weak_node_tolerances: Option<Vec<f64>>,
+    #[serde(default)]
+    pub quick: SweepQuick,
+}
+
+/// The Figure 17 normalisation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSection {
+    /// Sweep whose FEM cases give the reference: Richardson-extrapolated over its three
+    /// finest meshes when they refine by a constant ratio and converge monotonically, else
+    /// its finest mesh.
+    pub fem_sweep: String,
+    /// The Figure 17 sweep; its finest iGIMP case is the fallback reference when no FEM case
+    /// converged.
+    pub igimp_sweep: String,
+    pub source: String,
+}
+
+/// Every converged iGIMP case of `sweep` with h ≤ `max_element_size` lies within `tolerance`
+/// (relative) of the reference.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeviationExpectation {
+    pub sweep: String,
+    pub max_element_size: f64,
+    pub tolerance: f64,
+    pub source: String,
+}
+
+/// For each points-per-cell series of `sweep`, the distance to the reference does not grow
+/// by more than `slack` (relative) from one element size to the next smaller one.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConvergenceExpectation {
+    pub sweep: String,
+    pub slack: f64,
+    pub source: String,
+}
+
+/// At each element size of `sweep`, the spread (max − min) / min of the displacement over
+/// the non-zero weak-node tolerances is at most `tolerance`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpreadExpectation {
+    pub sweep: String,
+    pub tolerance: f64,
+    pub source: String,
+}
+
+/// Newton residuals printed in the paper (Tables 2 and 3), shown beside this code's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PaperResiduals {
+    /// e.g. "Table 2".
+    pub table: String,
+    /// Output file, e.g. `table2.md`.
+    pub file: String,
+    pub title: String,
+    /// The iGIMP case: sweep, element size and points per cell.
+    pub sweep: String,
+    pub element_size: f64,
+    pub points_per_cell: i64,
+    pub steps: Vec<i64>,
+    /// Per step, the normalised out-of-balance force after Newton iterations 1, 2, ….
+    pub residuals: Vec<Vec<f64>>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CompactionFigureKind {
+    /// Initial (grey) and final domains coloured by σ_yy (Figures 15, 18).
+    Domains,
+    /// Residual against Newton iteration of one load step, log scale (Figure 16).
+    Residuals,
+    /// Normalised maximum horizontal displacement against element size (Figure 17).
+    DisplacementConvergence,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompactionFigure {
+    pub id: String,
+    pub title: String,
+    pub kind: CompactionFigureKind,
+    pub sweep: String,
+    /// The case of domain and residual figures.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element_size: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points_per_cell: Option<i64>,
+    /// Load step of residual figures.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<i64>,
+}
+
+/// `studies/compaction.toml`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompactionStudy {
+    pub schema: i64,
+    pub name: String,
+    pub summary: String,
+    /// Always "compaction".
+    pub problem: String,
+    /// Main report file name in the output folder.
+    pub report_file: String,
+    pub block: BlockSection,
+    pub newton: NewtonSection,
+    pub weak_nodes: WeakNodeSection,
+    pub sweeps: Vec<CompactionSweep>,
+    pub reference: ReferenceSection,
+    #[serde(default)]
+    pub expect_deviation: Vec<DeviationExpectation>,
+    #[serde(default)]
+    pub expect_convergence: Vec<ConvergenceExpectation>,
+    #[serde(default)]
+    pub expect_weak_node_spread: Vec<SpreadExpectation>,
+    #[serde(default)]
+    pub paper_residuals: Vec<PaperResiduals>,
+    #[serde(default)]
+    pub figures: Vec<CompactionFigure>,
+}
+
+type V2 = SVector<f64, 2>;
+
+/// One case to solve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompactionCase {
+    pub id: String,
+    pub method: PlaneMethod,
+    pub spec: CompactionSpec,
+}
+
+fn number(x: f64) -> String {
+    format!("{x}")
+}
+
+impl PlaneStudy for CompactionStudy {
+    /// Checks the header, that every sweep's cases are valid problem inputs (the solver's own
+    /// validation names the field), and that references name existing sweeps and cases.
+    fn validate(&self, file: &str) -> Result<(), StudyError> {
+        plane::check_header(
+            file,
+            self.schema,
+            &self.problem,
+            "compaction",
+            &self.name,
+            &self.report_file,
+        )?;
+        if !(1..=10_000).contains(&self.block.load_steps) {
+            return Err(invalid(
+                file,
+                "block.load_steps",
+                self.block.load_steps,
+                "must be an integer in 1..=10000",
+            ));
+        }
+        if !(1..=1000).contains(&self.newton.max_iterations) {
+            return Err(invalid(
+                file,
+                "newton.max_iterations",
+                self.newton.max_iterations,
+                "must be in 1..=1000",
+            ));
+        }
+        if self.sweeps.is_empty() {
+            return Err(invalid(file, "sweeps", "[]", "must list at least one sweep"));
+        }
+        let mut ids = BTreeSet::new();
+        for (i, s) in self.sweeps.iter().enumerate() {
+            if !plane::ident_ok(&s.id) || !ids.insert(s.id.as_str()) {
+                return Err(invalid(
+                    file,
+                    format!("sweeps[{i}].id"),
+                    &s.id,
+                    "must be a unique [a-z0-9_-] name",
+                ));
+            }
+            for tier in [Tier::Full, Tier::Quick] {
+                let Some(plan) = self.plan(s, tier) else { continue };
+                let k = |f: &str| {
+                    format!(
+                        "sweeps[{i}].{}{f}",
+                        if tier == Tier::Quick { "quick." } else { "" }
+                    )
+                };
+                for (key, empty) in [
+                    ("methods", plan.methods.is_empty()),
+                    ("element_sizes", plan.element_sizes.is_empty()),
+                    ("points_per_cell", plan.points_per_cell.is_empty()),
+                    ("weak_node_tolerances", plan.tolerances.is_empty()),
+                ] {
+                    if empty {
+                        return Err(invalid(file, k(key), "[]", "must list at least one value"));
+                    }
+                }
+                if let Some(&p) = plan.points_per_cell.iter().find(|&&p| !(1..=16).contains(&p)) {
+                    return Err(invalid(
+                        file,
+                        k("points_per_cell"),
+                        p,
+                        "must be integers in 1..=16",
+                    ));
+                }
+                for c in self.sweep_cases(s, &plan) {
+                    c.spec.validate().map_err(|e| {
+                        invalid(
+                            file,
+                            format!("sweeps[{i}] case {}", c.id),
+                            e,
+                            "must be a valid compaction input",
+                        )
+                    })?;
+                }
+            }
+        }
+        let sweep_known = |key: String, id: &str| -> Result<&CompactionSweep, StudyError> {
+            self.sweeps
+                .iter()
+                .find(|s| s.id == id)
+                .ok_or_else(|| invalid(file, key, id, "must name a sweep"))
+        };
+        sweep_known("reference.fem_sweep".into(), &self.reference.fem_sweep)?;
+        sweep_known("reference.igimp_sweep".into(), &self.reference.igimp_sweep)?;
+        for (i, e) in self.expect_deviation.iter().enumerate() {
+            sweep_known(format!("expect_deviation[{i}].sweep"), &e.sweep)?;
+        }
+        for (i, e) in self.expect_convergence.iter().enumerate() {
+            sweep_known(format!("expect_convergence[{i}].sweep"), &e.sweep)?;
+        }
+        for (i, e) in self.expect_weak_node_spread.iter().enumerate() {
+            sweep_known(format!("expect_weak_node_spread[{i}].sweep"), &e.sweep)?;
+        }
+        for (i, p) in self.paper_residuals.iter().enumerate() {
+            sweep_known(format!("paper_residuals[{i}].sweep"), &p.sweep)?;
+            if p.steps.len() != p.residuals.len() {
+                return Err(invalid(
+                    file,
+                    format!("paper_residuals[{i}].residuals"),
+                    p.residuals.len(),
+                    "must give one list per step",
+                ));
+            }
+            if !(p.file.ends_with(".md") && plane::ident_ok(p.file.trim_end_matches(".md"))) {
+                return Err(invalid(
+                    file,
+                    format!("paper_residuals[{i}].file"),
+                    &p.file,
+                    "must be [a-z0-9_-]+.md",
+                ));
+            }
+        }
+        let mut fig_ids = BTreeSet::new();
+        for (i, f) in self.figures.iter().enumerate() {
+            if !plane::ident_ok(&f.id) || !fig_ids.insert(f.id.as_str()) {
+                return Err(invalid(
+                    file,
+                    format!("figures[{i}].id"),
+                    &f.id,
+                    "must be a unique [a-z0-9_-] name",
+                ));
+            }
+            sweep_known(format!("figures[{i}].sweep"), &f.sweep)?;
+            let needs_case = f.kind != CompactionFigureKind::DisplacementConvergence;
+            if needs_case && (f.element_size.is_none() || f.points_per_cell.is_none()) {
+                return Err(invalid(
+                    file,
+                    format!("figures[{i}]"),
+                    &f.id,
+                    "domain and residual figures need element_size and points_per_cell",
+                ));
+            }
+            if f.kind == CompactionFigureKind::Residuals && f.step.is_none() {
+                return Err(invalid(
+                    file,
+                    format!("figures[{i}].step"),
+                    "(missing)",
+                    "residual figures need a load step",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl CompactionStudy {
+    fn plan(&self, s: &CompactionSweep, tier: Tier) -> Option<SweepPlan> {
+        let q = &s.quick;
+        let quick = tier == Tier::Quick;
+        if quick && q.skip {
+            return None;
+        }
+        let pick = |full: &Vec<f64>, over: &Option<Vec<f64>>| {
+            if quick { over.clone() } else { None }.unwrap_or_else(|| full.clone())
+        };
+        let default_tol = vec![self.weak_nodes.tolerance];
+        Some(SweepPlan {
+            methods: if quick { q.methods.clone() } else { None }.unwrap_or_else(|| s.methods.clone()),
+            element_sizes: pick(&s.element_sizes, &q.element_sizes),
+            points_per_cell: if quick { q.points_per_cell.clone() } else { None }
+                .unwrap_or_else(|| s.points_per_cell.clone()),
+            tolerances: pick(
+                s.weak_node_tolerances.as_ref().unwrap_or(&default_tol),
+                &q.weak_node_tolerances,
+            ),
+        })
+    }
+
+    fn case_spec(&self, s: &CompactionSweep, h: f64, ppc: usize, tolerance: f64) -> CompactionSpec {
+        let b = &self.block;
+        CompactionSpec {
+            half_width: b.half_width,
+            height: b.height,
+            grid_extent: b.grid_extent,
+            element_size: h,
+            points_per_cell: ppc,
+            young_modulus: b.young_modulus,
+            poisson_ratio: b.poisson_ratio,
+            weight: b.weight,
+            yield_stress: s.yield_stress,
+            load_steps: b.load_steps.max(1) as usize,
+            newton: self.newton.settings(),
+            weak_node_tolerance: tolerance,
+            weak_node_treatment: self.weak_nodes.treatment,
+            ..CompactionSpec::default()
+        }
+    }
+
+    fn case_id(&self, method: PlaneMethod, spec: &CompactionSpec) -> String {
+        let material = match spec.yield_stress {
+            None => "elastic".to_string(),
+            Some(y) => format!("vm{}", number(y)),
+        };
+        let mut id = format!("{}-{material}-h{}", method.name(), number(spec.element_size));
+        if !method.is_fem() {
+            id.push_str(&format!("-p{}", spec.points_per_cell));
+            if spec.weak_node_tolerance != self.weak_nodes.tolerance {
+                id.push_str(&format!("-wn{}", number(spec.weak_node_tolerance)));
+            }
+        }
+        id
+    }
+
+    fn sweep_cases(&self, s: &CompactionSweep, plan: &SweepPlan) -> Vec<CompactionCase> {
+        let mut out = vec![];
+        for &method in &plan.methods {
+            let (ppcs, tols) = if method.is_fem() {
+                (vec![2], vec![self.weak_nodes.tolerance])
+            } else {
+                (plan.points_per_cell.clone(), plan.tolerances.clone())
+            };
+            for &ppc in &ppcs {
+                for &h in &plan.element_sizes {
+                    for &tol in &tols {
+                        let spec = self.case_spec(s, h, ppc.max(1) as usize, tol);
+                        out.push(CompactionCase {
+                            id: self.case_id(method, &spec),
+                            method,
+                            spec,
+                        });
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Every distinct case of the tier in file order, and the case ids of each sweep.
+    pub fn cases(&self, tier: Tier) -> (Vec<CompactionCase>, BTreeMap<String, Vec<String>>) {
+        let mut seen = BTreeSet::new();
+        let mut all = vec![];
+        let mut index = BTreeMap::new();
+        for s in &self.sweeps {
+            let Some(plan) = self.plan(s, tier) else { continue };
+            let cases = self.sweep_cases(s, &plan);
+            index.insert(s.id.clone(), cases.iter().map(|c| c.id.clone()).collect());
+            all.extend(cases.into_iter().filter(|c| seen.insert(c.id.clone())));
+        }
+        (all, index)
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct SweepPlan {
+    methods: Vec<PlaneMethod>,
+    element_sizes: Vec<f64>,
+    points_per_cell: Vec<i64>,
+    tolerances: Vec<f64>,
+}
+
+/// Result of one case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CompactionRecord {
+    pub id: String,
+    pub method: PlaneMethod,
+    /// Element size h.
+    pub h: f64,
+    /// Points per element along each axis; `None` (null) for FEM.
+    pub points_per_cell: Option<usize>,
+    pub yield_stress: Option<f64>,
+    pub weak_node_tolerance: f64,
+    pub status: CaseStatus,
+    pub failure: Option<FailureRecord>,
+    /// Bottom-right point's horizontal displacement plus half its domain's growth (Figure 17);
+    /// converged cases only.
+    pub max_horizontal_displacement: Option<f64>,
+    /// The same measure at the last converged step of a failed case.
+    pub last_converged_displacement: Option<f64>,
+    /// Weak-node constraints applied, summed over the load steps.
+    pub weak_nodes_treated: usize,
+    /// Material points (iGIMP) or elements (FEM).
+    pub points: usize,
+    pub newton_iterations: usize,
+    pub steps: Vec<StepRecord>,
+}
+
+/// The value Figure 17 is normalised by.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceRecord {
+    pub value: f64,
+    pub method: PlaneMethod,
+    /// The case(s) it comes from.
+    pub cases: Vec<String>,
+    /// Observed convergence order when Richardson-extrapolated.
+    pub observed_order: Option<f64>,
+    /// One sentence for captions and the report.
+    pub description: String,
+}
+
+/// `results.json` of the compaction study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CompactionResults {
+    #[serde(flatten)]
+    pub provenance: Provenance,
+    pub study: CompactionStudy,
+    pub sweep_cases: BTreeMap<String, Vec<String>>,
+    pub cases: Vec<CompactionRecord>,
+    pub reference: Option<ReferenceRecord>,
+    pub checks: Vec<CheckRecord>,
+    pub timing: Timing,
+}
+
+impl CompactionResults {
+    pub fn case(&self, id: &str) -> Option<&CompactionRecord> {
+        self.cases.iter().find(|c| c.id == id)
+    }
+
+    /// Copy with the wall-clock times zeroed.
+    pub fn without_timing(&self) -> Self {
+        let mut r = self.clone();
+        r.timing = r.timing.zeroed();
+        r
+    }
+
+    /// The cases of a sweep, in plan order.
+    pub fn sweep(&self, id: &str) -> Vec<&CompactionRecord> {
+        self.sweep_cases
+            .get(id)
+            .map_or(vec![], |ids| ids.iter().filter_map(|i| self.case(i)).collect())
+    }
+
+    /// The iGIMP case of a sweep at (h, points per cell) with the study's weak-node tolerance.
+    pub fn igimp_case(&self, sweep: &str, h: f64, ppc: usize) -> Option<&CompactionRecord> {
+        self.sweep(sweep).into_iter().find(|c| {
+            c.method == PlaneMethod::Igimp
+                && c.h == h
+                && c.points_per_cell == Some(ppc)
+                && c.weak_node_tolerance == self.study.weak_nodes.tolerance
+        })
+    }
+}
+
+/// A solved study: the results and the final domains of the cases the figures draw.
+#[derive(Debug, Clone)]
+pub struct CompactionRun {
+    pub results: CompactionResults,
+    pub domains: BTreeMap<String, Vec<DomainRecord>>,
+}
+
+impl CompactionRun {
+    pub fn summary(&self) -> RunSummary {
+        RunSummary::new(self.results.cases.iter().map(|c| c.status), &self.results.checks)
+    }
+}
+
+/// What a solver returns for one compaction case (iGIMP or FEM).
+struct CaseOutcome {
+    steps: Vec<StepReport>,
+    failure: Option<SolveError>,
+    max_horizontal_displacement: f64,
+    weak_nodes_treated: usize,
+    points: usize,
+    domains: Vec<DomainRecord>,
+}
+
+/// Updated-Lagrangian Q4 FEM (2×2 Gauss points, LDLᵀ) of the modelled half block with the
+/// same supports, material and gravity ramp: the Figure 17 reference. The measure is the
+/// horizontal displacement of the bottom-right node.
+fn solve_fem_q4(spec: &CompactionSpec) -> Result<CaseOutcome, String> {
+    let h = spec.element_size;
+    let cells = (
+        (spec.half_width / h).round() as usize,
+        (spec.height / h).round() as usize,
+    );
+    let size = V2::new(spec.half_width, spec.height);
+    let mesh = PlaneMesh::rectangle(V2::zeros(), size, cells, QuadElement::Q4).map_err(|e| e.to_string())?;
+    let tol = 1e-9 * h;
+    let mut fixed: Vec<(usize, usize)> = mesh.nodes_at(0, 0.0, tol).into_iter().map(|n| (n, 0)).collect();
+    fixed.extend(mesh.nodes_at(1, 0.0, tol).into_iter().map(|n| (n, 1)));
+    let corner = mesh.nearest_node(V2::new(spec.half_width, 0.0));
+    let elements = mesh.num_elements();
+    let loads = PlaneLoads {
+        gravity: V2::new(0.0, -spec.unit_weight()),
+        nodal_forces: vec![],
+    };
+    let settings = PlaneFemSettings {
+        gauss_points: Some(2),
+        newton: spec.newton,
+        load_steps: spec.load_steps,
+        linear_solver: LinearSolver::Ldlt,
+    };
+    let model = spec.model().map_err(|e| e.to_string())?;
+    let mut fem = PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings).map_err(|e| e.to_string())?;
+    let (steps, failure) = match fem.run() {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    Ok(CaseOutcome {
+        steps,
+        failure,
+        max_horizontal_displacement: fem.displacement(corner)[0],
+        weak_nodes_treated: 0,
+        points: elements,
+        domains: vec![],
+    })
+}
+
+fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
+    let s = &case.spec;
+    let mut rec = CompactionRecord {
+        id: case.id.clone(),
+        method: case.method,
+        h: s.element_size,
+        points_per_cell: (!case.method.is_fem()).then_some(s.points_per_cell),
+        yield_stress: s.yield_stress,
+        weak_node_tolerance: s.weak_node_tolerance,
+        status: CaseStatus::Rejected,
+        failure: None,
+        max_horizontal_displacement: None,
+        last_converged_displacement: None,
+        weak_nodes_treated: 0,
+        points: 0,
+        newton_iterations: 0,
+        steps: vec![],
+    };
+    let outcome = match case.method {
+        PlaneMethod::Igimp => solve_mpm(s).map_err(|e| e.to_string()).map(|o| CaseOutcome {
+            points: o.points.len(),
+            steps: o.steps,
+            failure: o.failure,
+            max_horizontal_displacement: o.max_horizontal_displacement,
+            weak_nodes_treated: o.weak_nodes_treated,
+            domains: o.points,
+        }),
+        PlaneMethod::FemQ4 => solve_fem_q4(s),
+        PlaneMethod::FemQ8 => Err("the compaction study uses Q4 elements (fem-q4)".to_string()),
+    };
+    match outcome {
+        Err(reason) => {
+            rec.failure = Some(rejection(reason));
+            (rec, vec![])
+        }
+        Ok(o) => {
+            rec.steps = step_records(&o.steps);
+            rec.newton_iterations = o.steps.iter().map(|s| s.newton.iterations()).sum();
+            rec.weak_nodes_treated = o.weak_nodes_treated;
+            rec.points = o.points;
+            let u = o
+                .max_horizontal_displacement
+                .is_finite()
+                .then_some(o.max_horizontal_displacement);
+            match &o.failure {
+                Some(e) => {
+                    rec.status = CaseStatus::Failed;
+                    rec.failure = Some(failure_record(e));
+                    rec.last_converged_displacement = u;
+                }
+                None => {
+                    rec.status = CaseStatus::Converged;
+                    rec.max_horizontal_displacement = u;
+                }
+            }
+            (rec, o.domains)
+        }
+    }
+}
+
+/// Richardson extrapolation of three values on meshes refined by a constant ratio r
+/// (coarse to fine): (limit, observed order). `None` if the differences do not shrink.
+pub fn richardson(values: [f64; 3], ratio: f64) -> Option<(f64, f64)> {
+    let (d1, d2) = (values[1] - values[0], values[2] - values[1]);
+    if d1 == 0.0 || d2 == 0.0 || d1.signum() != d2.signum() || d2.abs() >= d1.abs() {
+        return None;
+    }
+    let p = (d1 / d2).ln() / ratio.ln();
+    Some((values[2] + d2 / (ratio.powf(p) - 1.0), p))
+}
+
+fn figure17_reference(results: &CompactionResults) -> Option<ReferenceRecord> {
+    let mut fem: Vec<&CompactionRecord> = results
+        .sweep(&results.study.reference.fem_sweep)
+        .into_iter()
+        .filter(|c| c.method.is_fem() && c.max_horizontal_displacement.is_some())
+        .collect();
+    fem.sort_by(|a, b| b.h.total_cmp(&a.h));
+    if let Some(finest) = fem.last() {
+        let n = fem.len();
+        let u = |c: &CompactionRecord| c.max_horizontal_displacement.unwrap_or(f64::NAN);
+        if n >= 3 {
+            let (a, b, c) = (fem[n - 3], fem[n - 2], fem[n - 1]);
+            let r = a.h / b.h;
+            if ((b.h / c.h) - r).abs() < 1e-9 * r {
+                if let Some((limit, p)) = richardson([u(a), u(b), u(c)], r) {
+                    return Some(ReferenceRecord {
+                        value: limit,
+                        method: finest.method,
+                        cases: vec![a.id.clone(), b.id.clone(), c.id.clone()],
+                        observed_order: Some(p),
+                        description: format!(
+                            "{} extrapolated from h = {}, {}, {} (observed order {p:.2})",
+                            finest.method.label(),
+                            a.h,
+                            b.h,
+                            c.h
+                        ),
+                    });
+                }
+            }
+        }
+        return Some(ReferenceRecord {
+            value: u(finest),
+            method: finest.method,
+            cases: vec![finest.id.clone()],
+            observed_order: None,
+            description: format!("finest {} mesh, h = {}", finest.method.label(), finest.h),
+        });
+    }
+    let finest = results
+        .sweep(&results.study.reference.igimp_sweep)
+        .into_iter()
+        .filter(|c| c.method == PlaneMethod::Igimp && c.max_horizontal_displacement.is_some())
+        .min_by(|a, b| {
+            a.h.total_cmp(&b.h)
+                .then(b.points_per_cell.cmp(&a.points_per_cell))
+        })?;
+    Some(ReferenceRecord {
+        value: finest.max_horizontal_displacement?,
+        method: PlaneMethod::Igimp,
+        cases: vec![finest.id.clone()],
+        observed_order: None,
+        description: format!(
+            "finest iGIMP case (h = {}, {}×{} points per cell) — the 2D FEM comparator is not available yet",
+            finest.h,
+            finest.points_per_cell.unwrap_or(0),
+            finest.points_per_cell.unwrap_or(0)
+        ),
+    })
+}
+
+fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
+    let mut out = vec![];
+    let reference = results.reference.as_ref().map(|r| r.value);
+    let igimp = |sweep: &str| -> Vec<&CompactionRecord> {
+        results
+            .sweep(sweep)
+            .into_iter()
+            .filter(|c| c.method == PlaneMethod::Igimp && c.max_horizontal_displacement.is_some())
+            .collect()
+    };
+    let deviation = |c: &CompactionRecord| -> Option<f64> {
+        Some((c.max_horizontal_displacement? / reference? - 1.0).abs())
+    };
+    let against = results
+        .reference
+        .as_ref()
+        .map_or("no reference".into(), |r| r.description.clone());
+    for e in &results.study.expect_deviation {
+        let devs: Vec<f64> = igimp(&e.sweep)
+            .into_iter()
+            .filter(|c| c.h <= e.max_element_size)
+            .filter_map(deviation)
+            .collect();
+        let measured = (!devs.is_empty()).then(|| devs.iter().copied().fold(0.0, f64::max));
+        out.push(check_at_most(
+            &format!(
+                "{}-within-{}pc-h{}",
+                e.sweep,
+                100.0 * e.tolerance,
+                e.max_element_size
+            ),
+            format!(
+                "largest abs(u/u_ref − 1) over the {} completed iGIMP cases with h ≤ {} (u_ref: {against})",
+                devs.len(),
+                e.max_element_size
+            ),
+            measured,
+            e.tolerance,
+            &e.source,
+        ));
+    }
+    for e in &results.study.expect_convergence {
+        let cases = igimp(&e.sweep);
+        let ppcs: BTreeSet<usize> = cases.iter().filter_map(|c| c.points_per_cell).collect();
+        let mut worst: Option<f64> = None;
+        let mut series = 0;
+        for p in ppcs {
+            let mut s: Vec<&CompactionRecord> = cases
+                .iter()
+                .copied()
+                .filter(|c| {
+                    c.points_per_cell == Some(p)
+                        && c.weak_node_tolerance == results.study.weak_nodes.tolerance
+                })
+                .collect();
+            s.sort_by(|a, b| b.h.total_cmp(&a.h));
+            let d: Vec<f64> = s.iter().filter_map(|c| deviation(c)).collect();
+            if d.len() >= 2 {
+                series += 1;
+                for w in d.windows(2) {
+                    let growth = w[1] - w[0];
+                    worst = Some(worst.map_or(growth, |x: f64| x.max(growth)));
+                }
+            }
+        }
+        out.push(check_at_most(
+            &format!("{}-converges", e.sweep),
+            format!(
+                "largest growth of abs(u/u_ref − 1) from one element size to the next smaller, over {series} points-per-cell series (u_ref: {against})"
+            ),
+            worst,
+            e.slack,
+            &e.source,
+        ));
+    }
+    for e in &results.study.expect_weak_node_spread {
+        let cases: Vec<&CompactionRecord> = igimp(&e.sweep)
+            .into_iter()
+            .filter(|c| c.weak_node_tolerance > 0.0)
+            .collect();
+        let hs: BTreeSet<u64> = cases.iter().map(|c| c.h.to_bits()).collect();
+        let mut worst: Option<f64> = None;
+        for h in hs {
+            let u: Vec<f64> = cases
+                .iter()
+                .filter(|c| c.h.to_bits() == h)
+                .filter_map(|c| c.max_horizontal_displacement)
+                .collect();
+            if u.len() >= 2 {
+                let (lo, hi) = u
+                    .iter()
+                    .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+                let spread = (hi - lo) / lo.abs();
+                worst = Some(worst.map_or(spread, |w: f64| w.max(spread)));
+            }
+        }
+        out.push(check_at_most(
+            &format!("{}-weak-node-spread", e.sweep),
+            "largest (max − min)/min of the displacement over the non-zero weak-node tolerances at one element size".into(),
+            worst,
+            e.tolerance,
+            &e.source,
+        ));
+    }
+    out
+}
+
+/// Solve every case of the tier.
+pub fn run_study(study: &CompactionStudy, study_file: &str, tier: Tier) -> CompactionRun {
+    let start = std::time::Instant::now();
+    let (cases, sweep_cases) = study.cases(tier);
+    let cost = |c: &CompactionCase| {
+        let s = &c.spec;
+        (s.points_per_cell * s.points_per_cell) as f64 / (s.element_size * s.element_size)
+    };
+    let solved = plane::run_cases(&cases, cost, solve_case);
+    let drawn: BTreeSet<String> = study
+        .figures
+        .iter()
+        .filter(|f| f.kind == CompactionFigureKind::Domains)
+        .filter_map(|f| {
+            let s = study.sweeps.iter().find(|s| s.id == f.sweep)?;
+            let spec = study.case_spec(
+                s,
+                f.element_size?,
+                f.points_per_cell? as usize,
+                study.weak_nodes.tolerance,
+            );
+            Some(study.case_id(PlaneMethod::Igimp, &spec))
+        })
+        .collect();
+    let mut records = vec![];
+    let mut domains = BTreeMap::new();
+    let mut times = BTreeMap::new();
+    for ((rec, doms), secs) in solved {
+        times.insert(rec.id.clone(), secs);
+        if drawn.contains(&rec.id) {
+            domains.insert(rec.id.clone(), doms);
+        }
+        records.push(rec);
+    }
+    let mut results = CompactionResults {
+        provenance: Provenance::new(study_file, tier),
+        study: study.clone(),
+        sweep_cases,
+        cases: records,
+        reference: None,
+        checks: vec![],
+        timing: Timing {
+            wall_seconds: 0.0,
+            threads: rayon::current_num_threads(),
+            cases: times,
+        },
+    };
+    results.reference = figure17_reference(&results);
+    results.checks = compute_checks(&results);
+    results.timing.wall_seconds = start.elapsed().as_secs_f64();
+    CompactionRun { results, domains }
+}
+
+/// Write `<out>/<name>/results.json` and `domains.json`; returns the folder.
+pub fn write_outputs(out: &Path, run: &CompactionRun) -> Result<PathBuf, StudyError> {
+    plane::write_outputs(out, &run.results.study.name, &run.results, &run.domains)
+}
+
+pub fn read_results(dir: &Path) -> Result<CompactionResults, StudyError> {
+    plane::read_json(&dir.join("results.json"))
+}
+
+fn e3(x: Option<f64>) -> String {
+    x.map_or("—".into(), |v| format!("{v:.3e}"))
+}
+
+fn ppc_label(p: usize) -> String {
+    format!("{p}×{p} points/cell")
+}
+
+/// Table 2 / Table 3: this code's residuals beside the paper's, per step and iteration.
+pub fn residual_table(results: &CompactionResults, p: &PaperResiduals) -> String {
+    let mut s = format!("# {}: {}\n\n{}\n\n", p.table, p.title, results.provenance.line());
+    let case = results.igimp_case(&p.sweep, p.element_size, p.points_per_cell as usize);
+    let _ = writeln!(
+        s,
+        "Normalised out-of-balance force ‖f_int − f_ext‖ / ‖f_ext‖ after each Newton iteration \
+         (iteration k is the residual after the k-th solve), case `{}`. \"code\" is this code, \
+         \"paper\" the printed value.\n",
+        case.map_or("(not run in this tier)", |c| c.id.as_str())
+    );
+    let Some(case) = case else { return s };
+    if case.status != CaseStatus::Converged {
+        let _ = writeln!(
+            s,
+            "The case did not converge: {}.\n",
+            case.failure
+                .as_ref()
+                .map_or(String::new(), |f| format!("step {}: {}", f.step, f.reason))
+        );
+    }
+    let rows = p.residuals.iter().map(Vec::len).max().unwrap_or(0).max(
+        p.steps
+            .iter()
+            .filter_map(|&st| case.steps.iter().find(|r| r.step == st as usize))
+            .map(|r| r.residuals.len().saturating_sub(1))
+            .max()
+            .unwrap_or(0),
+    );
+    let _ = write!(s, "| iteration |");
+    for st in &p.steps {
+        let _ = write!(s, " step {st} code | step {st} paper |");
+    }
+    let _ = write!(s, "\n|---:|");
+    for _ in &p.steps {
+        let _ = write!(s, "---:|---:|");
+    }
+    s.push('\n');
+    for k in 1..=rows {
+        let _ = write!(s, "| {k} |");
+        for (j, &st) in p.steps.iter().enumerate() {
+            let code = case
+                .steps
+                .iter()
+                .find(|r| r.step == st as usize)
+                .and_then(|r| r.residuals.get(k).copied());
+            let _ = write!(s, " {} | {} |", e3(code), e3(p.residuals[j].get(k - 1).copied()));
+        }
+        s.push('\n');
+    }
+    s.push('\n');
+    s
+}
+
+fn figure17_table(results: &CompactionResults) -> String {
+    let sweep_id = &results.study.reference.igimp_sweep;
+    let cases = results.sweep(sweep_id);
+    let mut hs: Vec<f64> = cases.iter().map(|c| c.h).collect();
+    hs.sort_by(|a, b| b.total_cmp(a));
+    hs.dedup();
+    let ppcs: BTreeSet<usize> = cases.iter().filter_map(|c| c.points_per_cell).collect();
+    let fems: BTreeSet<PlaneMethod> = cases.iter().map(|c| c.method).filter(|m| m.is_fem()).collect();
+    let reference = results.reference.as_ref();
+    let mut s = format!(
+        "## Figure 17: maximum horizontal displacement\n\nBottom-right material point's horizontal displacement plus half the growth of its domain \
+         (FEM: bottom-right node). Normalised by u_ref = {} ({}). Each cell: u, then u/u_ref.\n\n| h |",
+        reference.map_or("—".into(), |r| format!("{:.6}", r.value)),
+        reference.map_or("no converged case", |r| r.description.as_str())
+    );
+    for p in &ppcs {
+        let _ = write!(s, " iGIMP {} |", ppc_label(*p));
+    }
+    for m in &fems {
+        let _ = write!(s, " {} |", m.label());
+    }
+    let _ = write!(s, "\n|---:|");
+    for _ in 0..ppcs.len() + fems.len() {
+        s.push_str("---:|");
+    }
+    s.push('\n');
+    let cell = |c: Option<&&CompactionRecord>| -> String {
+        match c {
+            None => "—".into(),
+            Some(c) => match (c.status, c.max_horizontal_displacement) {
+                (CaseStatus::Converged, Some(u)) => match reference {
+                    Some(r) => format!("{u:.5} ({:.4})", u / r.value),
+                    None => format!("{u:.5}"),
+                },
+                (CaseStatus::Failed, _) => {
+                    format!("failed at step {}", c.failure.as_ref().map_or(0, |f| f.step))
+                }
+                _ => "rejected".into(),
+            },
+        }
+    };
+    let tol = results.study.weak_nodes.tolerance;
+    for h in hs {
+        let _ = write!(s, "| {h} |");
+        for p in &ppcs {
+            let c = cases
+                .iter()
+                .find(|c| c.h == h && c.points_per_cell == Some(*p) && c.weak_node_tolerance == tol);
+            let _ = write!(s, " {} |", cell(c));
+        }
+        for m in &fems {
+            let _ = write!(
+                s,
+                " {} |",
+                cell(cases.iter().find(|c| c.h == h && c.method == *m))
+            );
+        }
+        s.push('\n');
+    }
+    s.push('\n');
+    s
+}
+
+fn cases_table(results: &CompactionResults) -> String {
+    let mut s = String::from(
+        "## All cases\n\n| case | method | h | points/cell | ρ_y | weak-node tol. | status | max horizontal u | weak nodes treated | Newton its/step |\n|---|---|---:|---:|---:|---:|---|---:|---:|---:|\n",
+    );
+    for c in &results.cases {
+        let u = c
+            .max_horizontal_displacement
+            .map(|u| format!("{u:.6}"))
+            .or_else(|| {
+                c.last_converged_displacement
+                    .map(|u| format!("({u:.4} at last converged step)"))
+            })
+            .unwrap_or("—".into());
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            c.id,
+            c.method.label(),
+            c.h,
+            c.points_per_cell.map_or("—".into(), |p| format!("{p}×{p}")),
+            c.yield_stress.map_or("elastic".into(), number),
+            c.weak_node_tolerance,
+            plane::status_word(c.status),
+            u,
+            c.weak_nodes_treated,
+            if c.steps.is_empty() {
+                "—".into()
+            } else {
+                format!("{:.2}", c.newton_iterations as f64 / c.steps.len() as f64)
+            }
+        );
+    }
+    s.push('\n');
+    s
+}
+
+/// The main report.
+pub fn report_markdown(results: &CompactionResults) -> String {
+    let spec = &results.study;
+    let (pass, fail, none) = plane::check_counts(&results.checks);
+    let count = |st| results.cases.iter().filter(|c| c.status == st).count();
+    let mut s = format!(
+        "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated. Cases: {} converged, {} failed, {} rejected.\n\n",
+        spec.name,
+        spec.summary,
+        results.provenance.line(),
+        count(CaseStatus::Converged),
+        count(CaseStatus::Failed),
+        count(CaseStatus::Rejected)
+    );
+    s.push_str(&figure17_table(results));
+    s.push_str(&plane::checks_markdown(&results.checks));
+    for p in &spec.paper_residuals {
+        let _ = writeln!(s, "- {}: [{}]({})", p.table, p.title, p.file);
+    }
+    s.push('\n');
+    s.push_str(&cases_table(results));
+    s.push_str(&plane::failures_markdown(
+        results
+            .cases
+            .iter()
+            .map(|c| (c.id.as_str(), c.status, c.failure.as_ref())),
+    ));
+    if !spec.figures.is_empty() {
+        s.push_str("## Figures\n\n");
+        for f in &spec.figures {
+            let _ = writeln!(s, "### {}\n\n![{}]({}.svg)\n", f.title, f.id, f.id);
+        }
+    }
+    s
+}
+
+fn figure_error(dir: &Path, id: &str) -> impl Fn(String) -> StudyError {
+    let path = dir.join(format!("{id}.svg")).display().to_string();
+    move |message| StudyError::Io {
+        path: path.clone(),
+        message,
+    }
+}
+
+fn render_figure(
+    results: &CompactionResults,
+    domains: &BTreeMap<String, Vec<DomainRecord>>,
+    dir: &Path,
+    f: &CompactionFigure,
+) -> Result<Option<String>, StudyError> {
+    let fail = figure_error(dir, &f.id);
+    let case = match (f.element_size, f.points_per_cell) {
+        (Some(h), Some(p)) => results.igimp_case(&f.sweep, h, p as usize),
+        _ => None,
+    };
+    match f.kind {
+        CompactionFigureKind::Domains => {
+            let Some(points) = case.and_then(|c| domains.get(&c.id)) else {
+                return Ok(None);
+            };
+            let c = case.expect("checked above");
+            let initial = points
+                .iter()
+                .map(|d| Domain {
+                    centre: d.x0,
+                    half: d.half0,
+                })
+                .collect();
+            let current = points
+                .iter()
+                .map(|d| Domain {
+                    centre: d.x,
+                    half: d.half,
+                })
+                .collect();
+            let title = match c.status {
+                CaseStatus::Converged => f.title.clone(),
+                _ => format!("{} (last converged step)", f.title),
+            };
+            domains_svg(
+                &title,
+                "σyy",
+                &[
+                    DomainLayer {
+                        label: "initial".into(),
+                        domains: initial,
+                        values: None,
+                        colour: None,
+                    },
+                    DomainLayer {
+                        label: String::new(),
+                        domains: current,
+                        values: Some(points.iter().map(|d| d.sigma_yy).collect()),
+                        colour: Some(0),
+                    },
+                ],
+                &[],
+            )
+            .map(Some)
+            .map_err(fail)
+        }
+        CompactionFigureKind::Residuals => {
+            let step = f.step.unwrap_or(1) as usize;
+            let Some(rec) = case.and_then(|c| c.steps.iter().find(|r| r.step == step)) else {
+                return Ok(None);
+            };
+            let code: Vec<(f64, f64)> = rec
+                .residuals
+                .iter()
+                .enumerate()
+                .skip(1)
+                .map(|(k, &r)| (k as f64, r))
+                .collect();
+            let mut series = vec![XySeries {
+                label: format!("this code, load step {step}"),
+                points: code,
+                line: true,
+                markers: true,
+            }];
+            for p in results.study.paper_residuals.iter().filter(|p| {
+                p.sweep == f.sweep
+                    && Some(p.element_size) == f.element_size
+                    && Some(p.points_per_cell) == f.points_per_cell
+            }) {
+                if let Some(j) = p.steps.iter().position(|&s| s as usize == step) {
+                    series.push(XySeries {
+                        label: format!("paper {}, load step {step}", p.table),
+                        points: p.residuals[j]
+                            .iter()
+                            .enumerate()
+                            .map(|(k, &r)| ((k + 1) as f64, r))
+                            .collect(),
+                        line: true,
+                        markers: true,
+                    });
+                }
+            }
+            let axes = XyAxes {
+                x_desc: "Newton iteration".into(),
+                y_desc: "normalised out-of-balance force".into(),
+                log_x: false,
+                log_y: true,
+                y_lines: vec![],
+                legend: LegendCorner::UpperRight,
+            };
+            xy_svg(&f.title, &axes, &series).map(Some).map_err(fail)
+        }
+        CompactionFigureKind::DisplacementConvergence => {
+            let Some(reference) = &results.reference else {
+                return Ok(None);
+            };
+            let cases = results.sweep(&f.sweep);
+            let tol = results.study.weak_nodes.tolerance;
+            let mut groups: BTreeMap<SeriesKey, Vec<(f64, f64)>> = BTreeMap::new();
+            for c in cases.iter().filter(|c| c.weak_node_tolerance == tol) {
+                if let Some(u) = c.max_horizontal_displacement {
+                    groups
+                        .entry((c.method, c.points_per_cell))
+                        .or_default()
+                        .push((c.h, u / reference.value));
+                }
+            }
+            let series: Vec<XySeries> = groups
+                .into_iter()
+                .map(|((m, p), pts)| XySeries {
+                    label: match p {
+                        Some(p) => format!("{}, {}", m.label(), ppc_label(p)),
+                        None => m.label().to_string(),
+                    },
+                    points: pts,
+                    line: true,
+                    markers: true,
+                })
+                .collect();
+            let axes = XyAxes {
+                x_desc: "element size h".into(),
+                y_desc: "u_max / u_ref".into(),
+                log_x: true,
+                log_y: false,
+                y_lines: vec![(0.99, "−1 %".into()), (1.01, "+1 %".into())],
+                legend: LegendCorner::LowerLeft,
+            };
+            // The full description is in the report; the title only names the reference.
+            let short = match (reference.method, reference.observed_order) {
+                (PlaneMethod::Igimp, _) => "finest iGIMP (no FEM)".to_string(),
+                (m, Some(_)) => format!("{}, extrapolated", m.label()),
+                (m, None) => format!("finest {}", m.label()),
+            };
+            let title = format!("{} (u_ref: {short})", f.title);
+            xy_svg(&title, &axes, &series).map(Some).map_err(fail)
+        }
+    }
+}
+
+/// A Figure 17 series: method and points per cell.
+type SeriesKey = (PlaneMethod, Option<usize>);
+
+/// Render the report, the residual tables and the figures from `dir`'s `results.json` and
+/// `domains.json`. Returns the files written.
+pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+    let results = read_results(dir)?;
+    let domains: BTreeMap<String, Vec<DomainRecord>> = plane::read_json(&dir.join("domains.json"))?;
+    let mut written = vec![];
+    plane::write_text(
+        &dir.join(&results.study.report_file),
+        &report_markdown(&results),
+        &mut written,
+    )?;
+    for p in &results.study.paper_residuals {
+        plane::write_text(&dir.join(&p.file), &residual_table(&results, p), &mut written)?;
+    }
+    for f in &results.study.figures {
+        if let Some(svg) = render_figure(&results, &domains, dir, f)? {
+            plane::write_text(&dir.join(format!("{}.svg", f.id)), &svg, &mut written)?;
+        }
+    }
+    Ok(written)
+}
+
+pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
+    let r = read_results(dir)?;
+    let mut files = vec![("report".to_string(), r.study.report_file.clone())];
+    files.extend(
+        r.study
+            .paper_residuals
+            .iter()
+            .map(|p| (format!("{}: {}", p.table, p.title), p.file.clone())),
+    );
+    files.extend(
+        r.study
+            .figures
+            .iter()
+            .map(|f| (f.title.clone(), format!("{}.svg", f.id))),
+    );
+    Ok(IndexEntry {
+        name: r.study.name,
+        summary: r.study.summary,
+        tier: r.provenance.tier,
+        checks: r.checks,
+        files,
+    })
+}

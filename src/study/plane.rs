@@ -1,0 +1,594 @@
+//! Machinery shared by the plane-strain studies: compaction (§5.2, [`super::compaction`]) and
+//! the cantilever (§5.3, [`super::cantilever`]).
+//!
+//! Their study files carry `problem = "compaction"` / `"cantilever"`; the `study` binary and
+//! [`crate::report::render_index`] dispatch on that key ([`problem_of_study`],
+//! [`problem_of_results`]) and otherwise use the column study's conventions: compute →
+//! `results.json` → render, rayon across cases with the records in study order, failed cases
+//! recorded with their step, reason and residuals, `--quick`, `--render-only`, `--check`.
+//!
+//! `results.json` holds no wall-clock data except its `timing` block, so two runs compare
+//! equal after [`Timing::zeroed`]. The material point domains drawn in the figures are kept
+//! in a compact `domains.json` beside it.
+
+use super::runner::{CaseStatus, FailureRecord, Software, StepRecord};
+use super::{StudyError, Tier};
+use crate::error::SolveError;
+use crate::mpm::WeakNodeTreatment;
+use crate::newton::StepReport;
+use rayon::prelude::*;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Method of a plane-strain case.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PlaneMethod {
+    /// Implicit GIMP (the paper's method).
+    Igimp,
+    /// Updated-Lagrangian FEM, 4-node quadrilaterals, 2×2 Gauss points (Figure 17 reference).
+    FemQ4,
+    /// Updated-Lagrangian FEM, 8-node quadrilaterals, 3×3 Gauss points (Figure 21).
+    FemQ8,
+}
+
+impl PlaneMethod {
+    pub fn name(self) -> &'static str {
+        match self {
+            PlaneMethod::Igimp => "igimp",
+            PlaneMethod::FemQ4 => "fem-q4",
+            PlaneMethod::FemQ8 => "fem-q8",
+        }
+    }
+    pub fn label(self) -> &'static str {
+        match self {
+            PlaneMethod::Igimp => "iGIMP",
+            PlaneMethod::FemQ4 => "Q4 FEM",
+            PlaneMethod::FemQ8 => "Q8 FEM",
+        }
+    }
+    pub fn is_fem(self) -> bool {
+        !matches!(self, PlaneMethod::Igimp)
+    }
+}
+
+/// Weak-node treatment as written in a study file (see [`crate::mpm::MpmSettings`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WeakNodeSection {
+    /// Nodes whose material volume share is below this fraction of an element are treated;
+    /// in [0, 1), 0 disables the treatment.
+    pub tolerance: f64,
+    pub treatment: WeakNodeTreatment,
+}
+
+/// A claim of the paper or the issue, checked against the results.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CheckRecord {
+    /// Short identifier, e.g. `fig17-within-1pc`.
+    pub id: String,
+    /// What is checked, in one sentence.
+    pub description: String,
+    /// The measured quantity compared with `limit` (e.g. a largest relative difference).
+    pub measured: Option<f64>,
+    pub limit: f64,
+    /// `None`: could not be evaluated (e.g. the cases it needs were rejected or not run).
+    pub pass: Option<bool>,
+    pub source: String,
+}
+
+/// Wall-clock data: the only part of `results.json` that changes from run to run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Timing {
+    pub wall_seconds: f64,
+    pub threads: usize,
+    /// Wall seconds of each case, by case id.
+    pub cases: BTreeMap<String, f64>,
+}
+
+impl Timing {
+    /// The same block with every time zeroed (case ids kept), for comparing two runs.
+    pub fn zeroed(&self) -> Self {
+        Timing {
+            wall_seconds: 0.0,
+            threads: 0,
+            cases: self.cases.keys().map(|k| (k.clone(), 0.0)).collect(),
+        }
+    }
+}
+
+/// Header fields every plane-strain `results.json` starts with.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    pub software: Software,
+    /// File name of the study file the inputs came from.
+    pub study_file: String,
+    pub tier: Tier,
+}
+
+impl Provenance {
+    pub fn new(study_file: &str, tier: Tier) -> Self {
+        Provenance {
+            software: Software {
+                name: env!("CARGO_PKG_NAME").to_string(),
+                version: env!("CARGO_PKG_VERSION").to_string(),
+            },
+            study_file: study_file.to_string(),
+            tier,
+        }
+    }
+
+    /// One line for the top of a report.
+    pub fn line(&self) -> String {
+        format!(
+            "Rendered from `results.json` by `study` ({} {}, {} tier, study file `{}`); regenerate, do not edit.",
+            self.software.name,
+            self.software.version,
+            tier_name(self.tier),
+            self.study_file
+        )
+    }
+}
+
+pub fn tier_name(t: Tier) -> &'static str {
+    match t {
+        Tier::Full => "full",
+        Tier::Quick => "quick",
+    }
+}
+
+/// Solve `cases` on the rayon pool, most expensive first (by `cost`), and return the results
+/// in the order of `cases` with each one's wall seconds: the output does not depend on the
+/// thread count.
+pub fn run_cases<C: Sync, R: Send>(
+    cases: &[C],
+    cost: impl Fn(&C) -> f64 + Sync,
+    solve: impl Fn(&C) -> R + Sync,
+) -> Vec<(R, f64)> {
+    let mut order: Vec<usize> = (0..cases.len()).collect();
+    order.sort_by(|&a, &b| cost(&cases[b]).total_cmp(&cost(&cases[a])).then(a.cmp(&b)));
+    let mut solved: Vec<(usize, R, f64)> = order
+        .par_iter()
+        .map(|&i| {
+            let t = Instant::now();
+            let r = solve(&cases[i]);
+            (i, r, t.elapsed().as_secs_f64())
+        })
+        .collect();
+    solved.sort_by_key(|s| s.0);
+    solved.into_iter().map(|(_, r, t)| (r, t)).collect()
+}
+
+/// Residual histories of converged load steps.
+pub fn step_records(steps: &[StepReport]) -> Vec<StepRecord> {
+    steps
+        .iter()
+        .map(|s| StepRecord {
+            step: s.step,
+            load_factor: s.load_factor,
+            residuals: s.newton.residuals.clone(),
+        })
+        .collect()
+}
+
+pub fn failure_record(e: &SolveError) -> FailureRecord {
+    FailureRecord {
+        step: e.step,
+        reason: e.failure.to_string(),
+        residuals: e.residuals.clone(),
+    }
+}
+
+/// A case that was not solved (step 0, no residuals).
+pub fn rejection(reason: impl Into<String>) -> FailureRecord {
+    FailureRecord {
+        step: 0,
+        reason: reason.into(),
+        residuals: vec![],
+    }
+}
+
+pub fn status_word(s: CaseStatus) -> &'static str {
+    match s {
+        CaseStatus::Converged => "converged",
+        CaseStatus::Failed => "failed",
+        CaseStatus::Rejected => "rejected",
+    }
+}
+
+/// A study, output or figure name: 1-64 characters from [a-z0-9_.-].
+pub fn ident_ok(s: &str) -> bool {
+    !s.is_empty()
+        && s.len() <= 64
+        && s.bytes()
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || matches!(b, b'-' | b'_' | b'.'))
+}
+
+/// Checks the keys every plane-strain study file starts with.
+pub fn check_header(
+    file: &str,
+    schema: i64,
+    problem: &str,
+    expected_problem: &str,
+    name: &str,
+    report_file: &str,
+) -> Result<(), StudyError> {
+    if schema != super::SCHEMA_VERSION {
+        return Err(invalid(
+            file,
+            "schema",
+            schema,
+            format!("must be {}", super::SCHEMA_VERSION),
+        ));
+    }
+    if problem != expected_problem {
+        return Err(invalid(
+            file,
+            "problem",
+            problem,
+            format!("must be {expected_problem:?}"),
+        ));
+    }
+    if !ident_ok(name) {
+        return Err(invalid(
+            file,
+            "name",
+            name,
+            "must be 1-64 characters from [a-z0-9_.-]",
+        ));
+    }
+    if !(report_file.ends_with(".md") && ident_ok(report_file.trim_end_matches(".md"))) {
+        return Err(invalid(
+            file,
+            "report_file",
+            report_file,
+            "must be a file name [a-z0-9_.-]+.md",
+        ));
+    }
+    Ok(())
+}
+
+/// A plane-strain study file: parsed strictly, then validated.
+pub trait PlaneStudy: DeserializeOwned {
+    /// Check every value; errors name the file, the key and its allowed range.
+    fn validate(&self, file: &str) -> Result<(), StudyError>;
+
+    /// Parse and validate a study file's text; `file` names it in errors.
+    fn parse(text: &str, file: &str) -> Result<Self, StudyError> {
+        let spec: Self = parse_toml(text, file)?;
+        spec.validate(file)?;
+        Ok(spec)
+    }
+
+    /// Read, parse and validate a study file.
+    fn load(path: &Path) -> Result<Self, StudyError> {
+        let text = std::fs::read_to_string(path).map_err(|e| StudyError::io(path, e))?;
+        Self::parse(&text, &path.display().to_string())
+    }
+}
+
+/// Write `<out>/<name>/results.json` (pretty) and `domains.json` (compact); returns the folder.
+pub fn write_outputs<R: Serialize, D: Serialize>(
+    out: &Path,
+    name: &str,
+    results: &R,
+    domains: &D,
+) -> Result<PathBuf, StudyError> {
+    let dir = out.join(name);
+    std::fs::create_dir_all(&dir).map_err(|e| StudyError::io(&dir, e))?;
+    write_json(&dir.join("domains.json"), domains, false)?;
+    write_json(&dir.join("results.json"), results, true)?;
+    Ok(dir)
+}
+
+/// A value outside its allowed range in a study file.
+pub fn invalid(
+    file: &str,
+    key: impl Into<String>,
+    value: impl ToString,
+    allowed: impl Into<String>,
+) -> StudyError {
+    StudyError::Invalid {
+        file: file.to_string(),
+        key: key.into(),
+        value: value.to_string(),
+        allowed: allowed.into(),
+    }
+}
+
+/// Parse a study file's TOML into `T` (unknown keys are errors through `deny_unknown_fields`).
+pub fn parse_toml<T: DeserializeOwned>(text: &str, file: &str) -> Result<T, StudyError> {
+    toml::from_str(text).map_err(|e| StudyError::Parse {
+        file: file.to_string(),
+        message: e.to_string().trim_end().to_string(),
+    })
+}
+
+/// The `problem` key of a study file, if it has one.
+pub fn problem_of_study(text: &str) -> Option<String> {
+    let v: toml::Value = toml::from_str(text).ok()?;
+    v.get("problem")?.as_str().map(str::to_string)
+}
+
+/// The `study.problem` recorded in `<dir>/results.json`, if readable.
+pub fn problem_of_results(dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(dir.join("results.json")).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    v.get("study")?.get("problem")?.as_str().map(str::to_string)
+}
+
+/// True for the problems handled here rather than by the column study.
+pub fn is_plane_problem(problem: &str) -> bool {
+    matches!(problem, "compaction" | "cantilever")
+}
+
+pub fn write_json<T: Serialize>(path: &Path, value: &T, pretty: bool) -> Result<(), StudyError> {
+    let text = if pretty {
+        serde_json::to_string_pretty(value)
+    } else {
+        serde_json::to_string(value)
+    }
+    .map_err(|e| StudyError::io(path, e))?;
+    std::fs::write(path, text + "\n").map_err(|e| StudyError::io(path, e))
+}
+
+pub fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T, StudyError> {
+    let text = std::fs::read_to_string(path).map_err(|e| StudyError::io(path, e))?;
+    serde_json::from_str(&text).map_err(|e| StudyError::Parse {
+        file: path.display().to_string(),
+        message: e.to_string(),
+    })
+}
+
+pub fn write_text(path: &Path, text: &str, written: &mut Vec<PathBuf>) -> Result<(), StudyError> {
+    std::fs::write(path, text).map_err(|e| StudyError::io(path, e))?;
+    written.push(path.to_path_buf());
+    Ok(())
+}
+
+/// (passed, failed, not evaluated).
+pub fn check_counts(checks: &[CheckRecord]) -> (usize, usize, usize) {
+    let mut n = (0, 0, 0);
+    for c in checks {
+        match c.pass {
+            Some(true) => n.0 += 1,
+            Some(false) => n.1 += 1,
+            None => n.2 += 1,
+        }
+    }
+    n
+}
+
+/// A check whose measured value must not exceed `limit`; not evaluated without a value.
+pub fn check_at_most(
+    id: &str,
+    description: String,
+    measured: Option<f64>,
+    limit: f64,
+    source: &str,
+) -> CheckRecord {
+    CheckRecord {
+        id: id.to_string(),
+        description,
+        measured,
+        limit,
+        pass: measured.map(|m| m <= limit),
+        source: source.to_string(),
+    }
+}
+
+pub fn checks_markdown(checks: &[CheckRecord]) -> String {
+    let mut s = String::from(
+        "## Checks\n\n| check | what | measured | limit | result | source |\n|---|---|---:|---:|---|---|\n",
+    );
+    for c in checks {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} |",
+            c.id,
+            c.description.replace('|', "\\|"),
+            c.measured.map_or("—".into(), |v| format!("{v:.4e}")),
+            c.limit,
+            match c.pass {
+                Some(true) => "pass",
+                Some(false) => "FAIL",
+                None => "not evaluated",
+            },
+            c.source.replace('|', "\\|")
+        );
+    }
+    s.push('\n');
+    s
+}
+
+/// Table of the cases that did not converge: id, status, step, reason and the last residuals.
+pub fn failures_markdown<'a>(
+    cases: impl Iterator<Item = (&'a str, CaseStatus, Option<&'a FailureRecord>)>,
+) -> String {
+    let mut rows = String::new();
+    for (id, status, f) in cases.filter(|c| c.1 != CaseStatus::Converged) {
+        let tail: Vec<String> = f
+            .map(|f| {
+                f.residuals
+                    .iter()
+                    .rev()
+                    .take(3)
+                    .rev()
+                    .map(|r| format!("{r:.2e}"))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let _ = writeln!(
+            rows,
+            "| {id} | {} | {} | {} | {} |",
+            status_word(status),
+            f.map_or(0, |f| f.step),
+            f.map_or(String::new(), |f| f.reason.replace('|', "/")),
+            if tail.is_empty() {
+                "—".to_string()
+            } else {
+                tail.join(", ")
+            }
+        );
+    }
+    if rows.is_empty() {
+        return String::new();
+    }
+    format!(
+        "## Cases that did not converge\n\n| case | status | step | reason | last residuals |\n|---|---|---:|---|---|\n{rows}\n"
+    )
+}
+
+/// What a plane-strain study contributes to `reports/index.md`.
+pub struct IndexEntry {
+    pub name: String,
+    pub summary: String,
+    pub tier: Tier,
+    pub checks: Vec<CheckRecord>,
+    /// (link text, file name) of the tables and figures.
+    pub files: Vec<(String, String)>,
+}
+
+impl IndexEntry {
+    pub fn markdown(&self) -> String {
+        let (pass, fail, none) = check_counts(&self.checks);
+        let mut s = format!(
+            "## {}\n\n{}\n\nTier: {}; checks: {pass} passed, {fail} failed, {none} not evaluated.\n\n",
+            self.name,
+            self.summary,
+            tier_name(self.tier)
+        );
+        for (text, file) in &self.files {
+            let _ = writeln!(s, "- [{text}]({}/{file})", self.name);
+        }
+        let _ = writeln!(
+            s,
+            "- [results.json]({0}/results.json) and the drawn domains in `{0}/domains.json`\n",
+            self.name
+        );
+        s
+    }
+}
+
+/// Outcome of running one plane-strain study file (for the binary's summary line).
+pub struct RunSummary {
+    pub cases: usize,
+    pub failed: usize,
+    pub rejected: usize,
+    pub checks: (usize, usize, usize),
+}
+
+impl RunSummary {
+    pub fn new(statuses: impl Iterator<Item = CaseStatus>, checks: &[CheckRecord]) -> Self {
+        let mut r = RunSummary {
+            cases: 0,
+            failed: 0,
+            rejected: 0,
+            checks: check_counts(checks),
+        };
+        for s in statuses {
+            r.cases += 1;
+            r.failed += usize::from(s == CaseStatus::Failed);
+            r.rejected += usize::from(s == CaseStatus::Rejected);
+        }
+        r
+    }
+}
+
+/// Solve (unless `render_only`) and render the plane-strain study in `file`, whose text and
+/// problem are given. Returns the study's output folder and its summary.
+pub fn run_file(
+    file: &Path,
+    text: &str,
+    problem: &str,
+    tier: Tier,
+    out: &Path,
+    render_only: bool,
+) -> Result<(PathBuf, Option<RunSummary>, Vec<PathBuf>), StudyError> {
+    let file_name = file.file_name().map_or_else(
+        || file.display().to_string(),
+        |f| f.to_string_lossy().into_owned(),
+    );
+    let shown = file.display().to_string();
+    let (dir, summary) = match problem {
+        "compaction" => {
+            let spec = super::compaction::CompactionStudy::parse(text, &shown)?;
+            let dir = out.join(&spec.name);
+            let summary = if render_only {
+                None
+            } else {
+                let run = super::compaction::run_study(&spec, &file_name, tier);
+                super::compaction::write_outputs(out, &run)?;
+                Some(run.summary())
+            };
+            (dir, summary)
+        }
+        "cantilever" => {
+            let spec = super::cantilever::CantileverStudy::parse(text, &shown)?;
+            let dir = out.join(&spec.name);
+            let summary = if render_only {
+                None
+            } else {
+                let run = super::cantilever::run_study(&spec, &file_name, tier);
+                super::cantilever::write_outputs(out, &run)?;
+                Some(run.summary())
+            };
+            (dir, summary)
+        }
+        other => {
+            return Err(invalid(
+                &shown,
+                "problem",
+                format!("{other:?}"),
+                "must be column, compaction or cantilever",
+            ))
+        }
+    };
+    let files = render_dir(&dir)?;
+    Ok((dir, summary, files))
+}
+
+/// Render the tables and figures of a plane-strain study folder from its results.
+pub fn render_dir(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+    match problem_of_results(dir).as_deref() {
+        Some("compaction") => super::compaction::render(dir),
+        Some("cantilever") => super::cantilever::render(dir),
+        _ => Err(StudyError::io(
+            &dir.join("results.json"),
+            "not a plane-strain study result",
+        )),
+    }
+}
+
+/// The index entry of a plane-strain study folder; `None` for other studies.
+pub fn index_entry(dir: &Path) -> Result<Option<IndexEntry>, StudyError> {
+    match problem_of_results(dir).as_deref() {
+        Some("compaction") => super::compaction::index_entry(dir).map(Some),
+        Some("cantilever") => super::cantilever::index_entry(dir).map(Some),
+        _ => Ok(None),
+    }
+}
+
+/// The (passed, failed, not evaluated) checks of a plane-strain study folder.
+pub fn folder_check_counts(dir: &Path) -> Result<(usize, usize, usize), StudyError> {
+    Ok(index_entry(dir)?.map_or((0, 0, 0), |e| check_counts(&e.checks)))
+}
+
+/// (name, summary) of a plane-strain study file for `study list`; `None` for other studies.
+pub fn catalogue_entry(file: &Path) -> Option<Result<(String, String), StudyError>> {
+    let text = std::fs::read_to_string(file).ok()?;
+    let shown = file.display().to_string();
+    match problem_of_study(&text)?.as_str() {
+        "compaction" => {
+            Some(super::compaction::CompactionStudy::parse(&text, &shown).map(|s| (s.name, s.summary)))
+        }
+        "cantilever" => {
+            Some(super::cantilever::CantileverStudy::parse(&text, &shown).map(|s| (s.name, s.summary)))
+        }
+        _ => None,
+    }
+}

@@ -1,0 +1,168 @@
+//! The compaction study (`studies/compaction.toml`, paper §5.2), quick tier: its outputs parse
+//! and re-render byte for byte with `study --render-only`, two runs give the same numbers,
+//! Figure 17's claim holds against the Q4 FEM reference, and failing cases are recorded.
+//!
+//! Everything is written to temporary folders, never to the repository's `reports/`.
+
+use igimp::study::compaction::{
+    read_results, render, run_study, write_outputs, CompactionRun, CompactionStudy,
+};
+use igimp::study::plane::PlaneStudy;
+use igimp::study::runner::CaseStatus;
+use igimp::study::Tier;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+fn study() -> CompactionStudy {
+    CompactionStudy::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/compaction.toml"))
+        .expect("studies/compaction.toml parses")
+}
+
+/// The quick tier, solved once for all tests of this file.
+fn quick() -> &'static CompactionRun {
+    static RUN: OnceLock<CompactionRun> = OnceLock::new();
+    RUN.get_or_init(|| run_study(&study(), "compaction.toml", Tier::Quick))
+}
+
+fn read_tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .map(|p| (p.clone(), std::fs::read(&p).unwrap()))
+        .collect()
+}
+
+/// results.json parses back; the report, Tables 2–3 and Figures 15–18 are written; deleting
+/// them and running `study compaction --render-only` recreates them byte for byte.
+#[test]
+fn compaction_quick_outputs_rerender_byte_identically() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("reports");
+    let dir = write_outputs(&out, quick()).unwrap();
+    render(&dir).unwrap();
+    let parsed = read_results(&dir).unwrap();
+    assert_eq!(parsed.cases.len(), quick().results.cases.len());
+    // serde_json may move a float by one ulp on the way back, so compare what the checks say.
+    let verdicts = |c: &[igimp::study::plane::CheckRecord]| -> Vec<(String, Option<bool>)> {
+        c.iter().map(|c| (c.id.clone(), c.pass)).collect()
+    };
+    assert_eq!(verdicts(&parsed.checks), verdicts(&quick().results.checks));
+    for f in [
+        "results.json",
+        "domains.json",
+        "report.md",
+        "table2.md",
+        "table3.md",
+        "fig15.svg",
+        "fig16.svg",
+        "fig17.svg",
+        "fig18.svg",
+    ] {
+        assert!(dir.join(f).is_file(), "missing {f}");
+    }
+    let table2 = std::fs::read_to_string(dir.join("table2.md")).unwrap();
+    assert!(
+        table2.contains("1.357e-3") && table2.contains("step 16 code"),
+        "{table2}"
+    );
+    let before = read_tree(&dir);
+    for (p, _) in before
+        .iter()
+        .filter(|(p, _)| !p.ends_with("results.json") && !p.ends_with("domains.json"))
+    {
+        std::fs::remove_file(p).unwrap();
+    }
+    let status = Command::new(env!("CARGO_BIN_EXE_study"))
+        .args(["compaction", "--render-only", "--out"])
+        .arg(&out)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    assert!(before == read_tree(&dir), "re-rendered files differ");
+    let index = std::fs::read_to_string(out.join("index.md")).unwrap();
+    assert!(
+        index.contains("compaction/fig17.svg") && index.contains("compaction/table3.md"),
+        "{index}"
+    );
+}
+
+/// Two runs of the quick tier agree in every field except the wall-clock times.
+#[test]
+fn compaction_quick_tier_is_deterministic() {
+    let again = run_study(&study(), "compaction.toml", Tier::Quick);
+    assert_eq!(again.results.without_timing(), quick().results.without_timing());
+    assert_eq!(again.domains, quick().domains);
+}
+
+/// Figure 17 (paper §5.2): for h ≤ 1/2 every points-per-cell setting that completes lies within
+/// 1 % of the converged reference, within 2 % at h = 1, and the distance to the reference does
+/// not grow as h decreases (0.1 % slack). The reference is the Q4 FEM extrapolated over its
+/// three finest quick-tier meshes (h = 1/4, 1/8, 1/16).
+#[test]
+fn compaction_figure17_within_one_percent_of_fem_reference() {
+    let r = &quick().results;
+    let reference = r.reference.as_ref().expect("a reference");
+    assert_eq!(reference.method.name(), "fem-q4", "{reference:?}");
+    let completed: Vec<_> = r
+        .sweep("fig17")
+        .into_iter()
+        .filter(|c| c.method.name() == "igimp" && c.status == CaseStatus::Converged)
+        .collect();
+    assert!(completed.len() >= 6);
+    for c in &completed {
+        let dev = (c.max_horizontal_displacement.unwrap() / reference.value - 1.0).abs();
+        let band = if c.h <= 0.5 { 0.01 } else { 0.02 };
+        assert!(
+            dev <= band,
+            "{}: {dev:.4} > {band} (reference {reference:?})",
+            c.id
+        );
+    }
+    for p in [2, 3] {
+        let mut s: Vec<_> = completed
+            .iter()
+            .filter(|c| c.points_per_cell == Some(p))
+            .collect();
+        s.sort_by(|a, b| b.h.total_cmp(&a.h));
+        let d: Vec<f64> = s
+            .iter()
+            .map(|c| (c.max_horizontal_displacement.unwrap() / reference.value - 1.0).abs())
+            .collect();
+        assert!(
+            d.len() >= 3 && d.windows(2).all(|w| w[1] <= w[0] + 1e-3),
+            "{p}x{p}: {d:?}"
+        );
+    }
+    for c in &r.checks {
+        assert_eq!(c.pass, Some(true), "{c:?}");
+    }
+}
+
+/// Cases that cannot complete are recorded, not fatal: one point per cell (all h), the
+/// plastic block at h = 1/2, and untreated weak nodes at h = 1 fail with their load step, the
+/// reason and the residuals of the failing step.
+#[test]
+fn compaction_failures_are_recorded_with_step_and_residuals() {
+    let r = &quick().results;
+    for id in [
+        "igimp-elastic-h1-p1",
+        "igimp-vm12000-h0.5-p2",
+        "igimp-elastic-h1-p2-wn0",
+    ] {
+        let c = r.case(id).unwrap_or_else(|| panic!("case {id}"));
+        assert_eq!(c.status, CaseStatus::Failed, "{id}");
+        let f = c.failure.as_ref().unwrap();
+        assert!(
+            f.step >= 1 && f.step <= 20 && !f.reason.is_empty() && !f.residuals.is_empty(),
+            "{id}: {f:?}"
+        );
+        assert_eq!(c.steps.len(), f.step - 1, "{id}");
+    }
+    let plastic = r.case("igimp-vm12000-h1-p2").unwrap();
+    assert_eq!(plastic.status, CaseStatus::Converged);
+    assert!(plastic.max_horizontal_displacement.unwrap() > 5.0);
+}
