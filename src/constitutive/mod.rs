@@ -85,6 +85,19 @@ pub enum Material {
     },
 }
 
+/// Linear elasticity, or von Mises plasticity when a yield stress is given: the material of
+/// every example in the paper.
+pub fn elastic_or_von_mises(
+    young_modulus: f64,
+    poisson_ratio: f64,
+    yield_stress: Option<f64>,
+) -> Result<Box<dyn ConstitutiveModel>, InputError> {
+    match yield_stress {
+        None => Ok(Box::new(LinearElastic::try_new(young_modulus, poisson_ratio)?)),
+        Some(ry) => Ok(Box::new(VonMises::try_new(young_modulus, poisson_ratio, ry)?)),
+    }
+}
+
 impl Material {
     /// Validate the parameters and build the model.
     pub fn build(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {

@@ -5,7 +5,7 @@
 //! (uniaxial strain).
 
 use crate::basis::Basis;
-use crate::constitutive::{lame, ConstitutiveModel, LinearElastic, VonMises};
+use crate::constitutive::{lame, ConstitutiveModel, LinearElastic};
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::grid::Grid;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
@@ -367,17 +367,7 @@ impl ColumnSpec {
 
     /// The constitutive model: linear elastic, or von Mises when `yield_stress` is set.
     pub fn model(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
-        match self.yield_stress {
-            None => Ok(Box::new(LinearElastic::try_new(
-                self.young_modulus,
-                self.poisson_ratio,
-            )?)),
-            Some(ry) => Ok(Box::new(VonMises::try_new(
-                self.young_modulus,
-                self.poisson_ratio,
-                ry,
-            )?)),
-        }
+        crate::constitutive::elastic_or_von_mises(self.young_modulus, self.poisson_ratio, self.yield_stress)
     }
 
     /// The MPM/GIMP solver for this column: grid [0, L0], base node fixed, gravity along −z.

@@ -8,7 +8,7 @@
 //! gravity ramped over the load steps (ρ0 g = weight / (2 half_width · height), density 1).
 
 use crate::basis::Basis;
-use crate::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
+use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
@@ -117,17 +117,7 @@ impl CompactionSpec {
 
     /// Linear elastic, or von Mises when `yield_stress` is set.
     pub fn model(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
-        match self.yield_stress {
-            None => Ok(Box::new(LinearElastic::try_new(
-                self.young_modulus,
-                self.poisson_ratio,
-            )?)),
-            Some(ry) => Ok(Box::new(VonMises::try_new(
-                self.young_modulus,
-                self.poisson_ratio,
-                ry,
-            )?)),
-        }
+        crate::constitutive::elastic_or_von_mises(self.young_modulus, self.poisson_ratio, self.yield_stress)
     }
 
     /// ρ0 g of the block (density 1).
