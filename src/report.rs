@@ -559,12 +559,12 @@ pub fn render_study(study_dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
     let results = read_results(study_dir)?;
     let mut written = vec![];
     let p = study_dir.join(&results.study.report_file);
-    std::fs::write(&p, report_markdown(&results)).map_err(|e| StudyError::io(&p, e))?;
+    crate::study::store::write_file(&p, report_markdown(&results).as_bytes())?;
     written.push(p);
     for fig in &results.study.figures {
         let svg = render_figure(&results, study_dir, fig)?;
         let p = study_dir.join(format!("{}.svg", fig.id));
-        std::fs::write(&p, svg).map_err(|e| StudyError::io(&p, e))?;
+        crate::study::store::write_file(&p, svg.as_bytes())?;
         written.push(p);
     }
     Ok(written)

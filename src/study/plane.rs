@@ -333,7 +333,7 @@ pub fn write_json<T: Serialize>(path: &Path, value: &T, pretty: bool) -> Result<
         serde_json::to_string(value)
     }
     .map_err(|e| StudyError::io(path, e))?;
-    std::fs::write(path, text + "\n").map_err(|e| StudyError::io(path, e))
+    super::store::write_file(path, (text + "\n").as_bytes())
 }
 
 pub fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T, StudyError> {
@@ -345,7 +345,7 @@ pub fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T, StudyError> {
 }
 
 pub fn write_text(path: &Path, text: &str, written: &mut Vec<PathBuf>) -> Result<(), StudyError> {
-    std::fs::write(path, text).map_err(|e| StudyError::io(path, e))?;
+    super::store::write_file(path, text.as_bytes())?;
     written.push(path.to_path_buf());
     Ok(())
 }
