@@ -140,6 +140,22 @@ pub(crate) fn draw_markers<
     Ok(())
 }
 
+/// The legend every igimp figure draws: boxed, white-backed, at `position`.
+pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> PlotResult<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FONT, LEGEND_PT))
+        .margin(12)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)
+}
+
 pub(crate) fn padded(lo: f64, hi: f64, frac: f64) -> (f64, f64) {
     let span = (hi - lo).abs().max(1e-12 * hi.abs().max(1.0));
     (lo - frac * span, hi + frac * span)
@@ -206,15 +222,7 @@ pub fn profile_svg(
         for (i, s) in series.iter().enumerate() {
             draw_markers(&mut chart, &s.points, Marker::nth(i), color(i), &s.label, false)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, LEGEND_PT))
-            .margin(12)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         root.present().map_err(err)?;
     }
     Ok(svg)
@@ -316,15 +324,7 @@ pub fn convergence_svg(
                     .map_err(err)?;
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .label_font((FONT, LEGEND_PT))
-            .margin(12)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
         root.present().map_err(err)?;
     }
     Ok(svg)

@@ -7,7 +7,7 @@
 //! function of the data so that `study --render-only` is byte-identical.
 
 use crate::plot::{
-    color, draw_markers, err, padded, Marker, PlotResult, AXIS_DESC_PT, CAPTION_PT, FONT, LEGEND_PT, SIZE,
+    color, draw_legend, draw_markers, err, padded, Marker, PlotResult, AXIS_DESC_PT, CAPTION_PT, FONT, SIZE,
     TICK_PT,
 };
 use plotters::prelude::*;
@@ -190,15 +190,7 @@ pub fn domains_svg(
             )?;
         }
         if legend {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .label_font((FONT, LEGEND_PT))
-                .margin(12)
-                .background_style(WHITE.mix(0.9))
-                .border_style(BLACK)
-                .draw()
-                .map_err(err)?;
+            draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         }
         if value_range.is_some() {
             let mut bar = ChartBuilder::on(&right)
@@ -377,15 +369,7 @@ pub fn xy_svg(title: &str, axes: &XyAxes, series: &[XySeries]) -> PlotResult<Str
                             });
                     }
                 }
-                chart
-                    .configure_series_labels()
-                    .position(axes.legend.position())
-                    .label_font((FONT, LEGEND_PT))
-                    .margin(12)
-                    .background_style(WHITE.mix(0.9))
-                    .border_style(BLACK)
-                    .draw()
-                    .map_err(err)?;
+                draw_legend(&mut chart, axes.legend.position())?;
             }};
         }
         match (axes.log_x, axes.log_y) {
