@@ -51,6 +51,8 @@ fn run(target: f64, solver: LinearSolver) {
         matrix: &mut matrix,
         trials: &mut trials,
         du_nodal: &mut du,
+        ghost: None,
+        fixed_forces: &mut Vec::new(),
     };
     let u = vec![-1e-4; dofs.len()];
     let mut r = vec![0.0; dofs.len()];

@@ -9,9 +9,10 @@
 
 use crate::constitutive::ConstitutiveModel;
 use crate::error::StepFailure;
+use crate::ghost::GhostOperator;
 use crate::kinematics::{evaluate_point, PointState, PointTrial};
 use crate::linear::SparseSystem;
-use crate::newton::{self, NewtonReport, NewtonSettings, NonlinearSystem};
+use crate::newton::{self, NewtonReport, NewtonSettings, NonlinearSystem, ResidualNorm};
 use crate::tensor::ij;
 use nalgebra::{SMatrix, SVector};
 use rayon::prelude::*;
@@ -250,6 +251,11 @@ pub struct LoadStepSystem<'a, const D: usize> {
     pub trials: &'a mut Vec<Option<PointTrial<D>>>,
     /// Nodal displacement increment at the last evaluation.
     pub du_nodal: &'a mut Vec<f64>,
+    /// Ghost penalty of the step (material point solvers), if on.
+    pub ghost: Option<&'a GhostOperator<D>>,
+    /// Internal force at the dofs without an equation (fixed ones: the support reactions
+    /// plus the external force there), indexed by nodal dof, at the last evaluation.
+    pub fixed_forces: &'a mut Vec<f64>,
 }
 
 impl<const D: usize> LoadStepSystem<'_, D> {
@@ -290,20 +296,27 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             return Err(StepFailure::Kinematics { point, reason });
         }
         f_int.iter_mut().for_each(|v| *v = 0.0);
+        self.fixed_forces.clear();
+        self.fixed_forces.resize(self.dofs.num_dofs(), 0.0);
         let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
         let mut eqs = [None; MAX_POINT_NODES * 3];
         for p in 0..self.states.len() {
             let t = self.trials[p].as_ref().expect("evaluated");
             let m = self.spatial_gradients(p, t, &mut gx, &mut eqs);
             let v = t.volume;
+            let nodes = self.table.point(p).0;
             for k in 0..m {
                 for i in 0..D {
-                    if let Some(e) = eqs[k * D + i] {
-                        let s: f64 = (0..D).map(|j| t.sigma[(i, j)] * gx[k][j]).sum();
-                        f_int[e] += s * v; // eq (29)
+                    let s: f64 = (0..D).map(|j| t.sigma[(i, j)] * gx[k][j]).sum();
+                    match eqs[k * D + i] {
+                        Some(e) => f_int[e] += s * v, // eq (29)
+                        None => self.fixed_forces[nodes[k] * D + i] += s * v,
                     }
                 }
             }
+        }
+        if let Some(g) = self.ghost {
+            g.add_residual(self.dofs, self.du_nodal, f_int, Some(self.fixed_forces));
         }
         Ok(())
     }
@@ -427,6 +440,9 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                     }
                 });
         }
+        if let Some(g) = self.ghost {
+            g.add_tangent(self.dofs, self.matrix);
+        }
     }
 }
 
@@ -447,8 +463,14 @@ impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
         self.assemble_tangent();
         self.matrix.solve_in_place(rhs).map_err(StepFailure::Singular)
     }
-    fn reference_norm(&self) -> f64 {
-        self.f_ext.iter().map(|x| x * x).sum::<f64>().sqrt()
+    fn reference_norm(&self, norm: ResidualNorm) -> f64 {
+        let ext: f64 = self.f_ext.iter().map(|x| x * x).sum();
+        match norm {
+            ResidualNorm::External => ext.sqrt(),
+            // ‖f_ext + f_reaction‖ over all dofs: f_ext at the free dofs and, at the fixed
+            // ones, f_ext + reaction = f_int of the last evaluation.
+            ResidualNorm::Total => (ext + self.fixed_forces.iter().map(|x| x * x).sum::<f64>()).sqrt(),
+        }
     }
 }
 
@@ -462,6 +484,8 @@ pub struct StepWorkspace<const D: usize> {
     pub matrix: SparseSystem,
     pub trials: Vec<Option<PointTrial<D>>>,
     pub du_nodal: Vec<f64>,
+    /// Internal force at the fixed dofs at the last evaluation (see [`LoadStepSystem`]).
+    pub fixed_forces: Vec<f64>,
 }
 
 /// What a load step applies, besides the material model and the committed states.
@@ -477,6 +501,8 @@ pub struct StepInput<'a, const D: usize> {
     pub point_forces: &'a [SVector<f64, D>],
     /// Forces applied directly to nodal dofs (dof = node·D + axis).
     pub nodal_forces: &'a [(usize, f64)],
+    /// Ghost penalty of the step, built on the same grid ([`crate::ghost`]).
+    pub ghost: Option<&'a GhostOperator<D>>,
 }
 
 impl<const D: usize> StepWorkspace<D> {
@@ -488,7 +514,11 @@ impl<const D: usize> StepWorkspace<D> {
         f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
     ) -> R {
         let dofs = DofMap::build(input.num_nodes, &self.table, input.fixed, input.ties);
-        self.matrix.set_pattern(dofs.pattern(&self.table));
+        let mut columns = dofs.pattern(&self.table);
+        if let Some(g) = input.ghost {
+            g.add_pattern(&dofs, &mut columns);
+        }
+        self.matrix.set_pattern(columns);
         let mut nodal = vec![0.0; dofs.num_dofs()];
         map_point_forces(&self.table, input.point_forces, &mut nodal);
         for &(dof, force) in input.nodal_forces {
@@ -505,6 +535,8 @@ impl<const D: usize> StepWorkspace<D> {
             matrix: &mut self.matrix,
             trials: &mut self.trials,
             du_nodal: &mut self.du_nodal,
+            ghost: input.ghost,
+            fixed_forces: &mut self.fixed_forces,
         };
         f(&mut system)
     }

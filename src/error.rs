@@ -61,6 +61,13 @@ pub fn require_count(field: &str, value: usize, min: usize) -> Result<(), InputE
 pub enum StepFailure {
     #[error("Newton did not converge in {iterations} iterations (last normalised residual {last:.3e})")]
     NotConverged { iterations: usize, last: f64 },
+    #[error("Newton stalled at its round-off floor after {iterations} iterations: the residual stays near {floor:.1e} (best {best:.1e}), above the tolerance {tolerance:.1e}; the tangent is too ill-conditioned for this tolerance (e.g. near-incompressible material): raise newton.tolerance above the floor or change the discretisation")]
+    Stalled {
+        iterations: usize,
+        floor: f64,
+        best: f64,
+        tolerance: f64,
+    },
     #[error("non-finite residual or update at Newton iteration {iteration}")]
     NonFinite { iteration: usize },
     #[error("the tangent matrix could not be factorised: {0}")]
@@ -71,13 +78,25 @@ pub enum StepFailure {
     Kinematics { point: usize, reason: String },
 }
 
-/// A load step that failed, with the Newton residual history of that step.
+/// A load step that failed, with the Newton residual history of its last attempt.
 #[derive(Debug, Clone, PartialEq, Error)]
-#[error("load step {step}: {failure}; residual history {residuals:?}")]
+#[error("load step {step}{}: {failure}; residual history {residuals:?}", cut_note(*.attempts, *.load_factor))]
 pub struct SolveError {
     /// Load step number, counted from 1.
     pub step: usize,
     pub failure: StepFailure,
-    /// Normalised out-of-balance force per Newton iteration of the failing step.
+    /// Normalised out-of-balance force per Newton iteration of the failing attempt.
     pub residuals: Vec<f64>,
+    /// Attempts made at this load step (1 without adaptive cutbacks).
+    pub attempts: usize,
+    /// Load factor the failing attempt aimed at.
+    pub load_factor: f64,
+}
+
+fn cut_note(attempts: usize, load_factor: f64) -> String {
+    if attempts > 1 {
+        format!(" (after {attempts} attempts, the last at load factor {load_factor:.6}, at the cutback floor)")
+    } else {
+        String::new()
+    }
 }

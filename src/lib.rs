@@ -40,6 +40,7 @@ pub mod basis;
 pub mod constitutive;
 pub mod error;
 pub mod fem;
+pub mod ghost;
 pub mod grid;
 pub mod kinematics;
 pub mod linear;

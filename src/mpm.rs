@@ -3,10 +3,11 @@
 use crate::assembly::{StepInput, StepWorkspace, SupportTable};
 use crate::basis::{Basis, Support};
 use crate::constitutive::ConstitutiveModel;
-use crate::error::{require_count, InputError, SolveError, StepFailure};
+use crate::error::{require_count, InputError, StepFailure};
+use crate::ghost::{cell_fill, GhostOperator, GhostSettings};
 use crate::grid::Grid;
 use crate::kinematics::stretch_tensor;
-use crate::newton::{LoadStepping, NewtonSettings, StepReport};
+use crate::newton::{Increment, LoadStepping, NewtonSettings};
 use crate::particles::MaterialPoints;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
@@ -45,6 +46,10 @@ pub struct MpmSettings {
     /// hyperelastic and associative plastic models, LDLᵀ/LLᵀ with LU as fallback.
     #[serde(default)]
     pub linear_solver: crate::linear::LinearSolver,
+    /// Ghost penalty on the grid faces of nearly empty cells ([`crate::ghost`]); off by
+    /// default here, chosen per problem from measurements.
+    #[serde(default)]
+    pub ghost: GhostSettings,
 }
 
 /// How the committed volume V_p^n of a material point is obtained (eq 28).
@@ -77,6 +82,7 @@ pub enum WeakNodeTreatment {
 impl MpmSettings {
     pub fn validate(&self) -> Result<(), InputError> {
         self.newton.validate()?;
+        self.ghost.validate()?;
         if !(self.weak_node_tolerance >= 0.0 && self.weak_node_tolerance < 1.0) {
             return Err(InputError::new(
                 "weak_node_tolerance",
@@ -116,6 +122,9 @@ pub struct MpmSolver<const D: usize> {
     pub settings: MpmSettings,
     step: usize,
     work: StepWorkspace<D>,
+    ghost: GhostOperator<D>,
+    /// Total load factor of the committed state.
+    load_factor: f64,
 }
 
 impl<const D: usize> MpmSolver<D> {
@@ -174,6 +183,8 @@ impl<const D: usize> MpmSolver<D> {
             settings,
             step: 0,
             work: StepWorkspace::default(),
+            ghost: GhostOperator::default(),
+            load_factor: 0.0,
         })
     }
 
@@ -219,6 +230,32 @@ impl<const D: usize> MpmSolver<D> {
     /// is the only nodal displacement the solver has.
     pub fn step_increment(&self) -> &[f64] {
         &self.work.du_nodal
+    }
+
+    /// Total load factor of the committed state (the last converged increment).
+    pub fn load_factor(&self) -> f64 {
+        self.load_factor
+    }
+
+    /// The ghost operator of the last increment (faces, cell fill fractions).
+    pub fn ghost(&self) -> &GhostOperator<D> {
+        &self.ghost
+    }
+
+    /// Form the ghost operator for the current configuration (after [`Self::build_supports`]).
+    pub fn build_ghost(&mut self) {
+        if self.settings.ghost.is_on() {
+            cell_fill(
+                &self.grid,
+                self.settings.basis,
+                &self.points.position,
+                &self.points.half_length,
+                self.points.state.iter().map(|s| s.volume),
+                self.ghost.fill_mut(),
+            );
+        }
+        self.ghost
+            .build(&self.grid, &self.settings.ghost, self.model.young_modulus());
     }
 
     /// Supports of the last [`Self::build_supports`].
@@ -295,43 +332,57 @@ impl<const D: usize> MpmSolver<D> {
         forces
     }
 
+    /// Domain half-lengths after committing F (eqs 37/39).
+    fn updated_half_length(&self, p: usize, f: &nalgebra::Matrix3<f64>) -> SVector<f64, D> {
+        let r0 = self.points.half_length0[p];
+        match self.settings.domain_update {
+            DomainUpdate::Stretch => {
+                let u = stretch_tensor(f);
+                SVector::<f64, D>::from_fn(|a, _| r0[a] * u[(a, a)])
+            }
+            DomainUpdate::FDiagonal => SVector::<f64, D>::from_fn(|a, _| r0[a] * f[(a, a)]),
+            DomainUpdate::Fixed => r0,
+        }
+    }
+
     /// Commit the converged step: states, positions (x += Σ S Δu) and domains (eqs 37/39).
-    fn commit(&mut self) {
+    /// A domain that would collapse (length ≤ 0) fails the increment before anything is
+    /// committed, so that the load stepping can retry it with a smaller one.
+    fn commit(&mut self) -> Result<(), StepFailure> {
+        for p in 0..self.points.len() {
+            let trial = self.work.trials[p].as_ref().expect("converged trial");
+            let h = self.updated_half_length(p, &trial.committed().f);
+            if let Some(a) = (0..D).find(|&a| !(h[a] > 0.0 && h[a].is_finite())) {
+                return Err(StepFailure::Kinematics {
+                    point: p,
+                    reason: format!(
+                        "domain collapsed along axis {a} (updated half-length {:.3e})",
+                        h[a]
+                    ),
+                });
+            }
+        }
         for p in 0..self.points.len() {
             let trial = self.work.trials[p].as_ref().expect("converged trial");
             let new_state = trial.committed();
             self.points.state[p] = new_state;
             let du = self.work.table.interpolate(p, &self.work.du_nodal);
             self.points.position[p] += du;
-            let r0 = self.points.half_length0[p];
-            let f = new_state.f;
-            self.points.half_length[p] = match self.settings.domain_update {
-                DomainUpdate::Stretch => {
-                    let u = stretch_tensor(&f);
-                    SVector::<f64, D>::from_fn(|a, _| r0[a] * u[(a, a)])
-                }
-                DomainUpdate::FDiagonal => SVector::<f64, D>::from_fn(|a, _| r0[a] * f[(a, a)]),
-                DomainUpdate::Fixed => r0,
-            };
+            self.points.half_length[p] = self.updated_half_length(p, &new_state.f);
             if self.settings.volume_update == VolumeUpdate::DomainProduct {
                 // The paper's V_p^n: the product of the domain lengths (unit out-of-plane).
                 let h = self.points.half_length[p];
                 self.points.state[p].volume = (0..D).map(|a| 2.0 * h[a]).product();
             }
         }
+        Ok(())
     }
 }
 
 impl<const D: usize> LoadStepping for MpmSolver<D> {
-    fn step(&mut self) -> Result<StepReport, SolveError> {
-        let step = self.step + 1;
-        let fail = |failure, residuals| SolveError {
-            step,
-            failure,
-            residuals,
-        };
-        let load_factor = step as f64 / self.settings.load_steps as f64;
-        self.build_supports().map_err(|f| fail(f, vec![]))?;
+    fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
+        self.build_supports().map_err(|f| (f, vec![]))?;
+        self.build_ghost();
         let forces = self.external_point_forces(load_factor);
         let (weak, ties) = self.weak_nodes();
         let mut fixed = self.fixed.clone();
@@ -341,6 +392,7 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
                 .filter(|n| !tied.contains(n))
                 .flat_map(|&n| (0..D).map(move |a| (n, a))),
         );
+        let ghost = self.settings.ghost.is_on().then_some(&self.ghost);
         let input = StepInput {
             model: self.model.as_ref(),
             states: &self.points.state,
@@ -349,17 +401,13 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
             ties: &ties,
             point_forces: &forces,
             nodal_forces: &[],
+            ghost,
         };
         self.work.matrix.set_solver(self.settings.linear_solver);
-        let report = self
-            .work
-            .solve(&input, &self.settings.newton)
-            .map_err(|(f, r)| fail(f, r))?;
-        self.commit();
-        self.step = step;
-        Ok(StepReport {
-            step,
-            load_factor,
+        let report = self.work.solve(&input, &self.settings.newton)?;
+        self.commit().map_err(|f| (f, report.residuals.clone()))?;
+        self.load_factor = load_factor;
+        Ok(Increment {
             newton: report,
             weak_nodes: weak.len(),
         })
@@ -367,7 +415,13 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
     fn steps_done(&self) -> usize {
         self.step
     }
+    fn set_steps_done(&mut self, n: usize) {
+        self.step = n;
+    }
     fn load_steps(&self) -> usize {
         self.settings.load_steps
+    }
+    fn newton_settings(&self) -> &NewtonSettings {
+        &self.settings.newton
     }
 }

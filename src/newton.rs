@@ -21,6 +21,36 @@ pub struct NewtonSettings {
     /// asymptotic quadratic rate is unaffected.
     #[serde(default)]
     pub line_search: bool,
+    /// What the out-of-balance force is normalised by.
+    #[serde(default)]
+    pub residual_norm: ResidualNorm,
+    /// Adaptive load stepping: a load step that fails is retried from the last committed
+    /// state with half the increment, at most this many times in a row, so the smallest
+    /// increment is 2^-max_cutbacks of the nominal one (default 6: 1/64). 0 = fixed steps.
+    #[serde(default = "default_cutbacks")]
+    pub max_cutbacks: u32,
+}
+
+fn default_cutbacks() -> u32 {
+    DEFAULT_CUTBACKS
+}
+
+/// Default of [`NewtonSettings::max_cutbacks`]: the floor 1/64 of the nominal increment.
+pub const DEFAULT_CUTBACKS: u32 = 6;
+
+/// Most halvings of a load increment ([`NewtonSettings::max_cutbacks`]): 2^-20 of a step.
+pub const MAX_CUTBACKS: u32 = 20;
+
+/// How the out-of-balance force is normalised in the convergence test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ResidualNorm {
+    /// ‖f_int − f_ext‖ / ‖f_ext‖ over the free dofs.
+    #[default]
+    External,
+    /// ‖f_int − f_ext‖ over the free dofs / ‖f_ext + f_reaction‖ over all dofs (the support
+    /// reactions included), as the paper's group normalises it (Tables 2 and 3).
+    Total,
 }
 
 impl Default for NewtonSettings {
@@ -29,6 +59,8 @@ impl Default for NewtonSettings {
             tolerance: 1e-9,
             max_iterations: 30,
             line_search: false,
+            residual_norm: ResidualNorm::External,
+            max_cutbacks: DEFAULT_CUTBACKS,
         }
     }
 }
@@ -51,6 +83,13 @@ impl NewtonSettings {
                 format!("must be <= {MAX_NEWTON_ITERATIONS}"),
             ));
         }
+        if self.max_cutbacks > MAX_CUTBACKS {
+            return Err(InputError::new(
+                "newton.max_cutbacks",
+                self.max_cutbacks,
+                format!("must be <= {MAX_CUTBACKS}"),
+            ));
+        }
         Ok(())
     }
 }
@@ -66,8 +105,9 @@ pub trait NonlinearSystem {
     fn evaluate(&mut self, u: &[f64], residual: &mut [f64]) -> Result<(), StepFailure>;
     /// Solve `K x = rhs` in place with the tangent formed at the last `evaluate`.
     fn solve_tangent(&mut self, rhs: &mut [f64]) -> Result<(), StepFailure>;
-    /// Norm used to normalise the residual (‖f_ext‖).
-    fn reference_norm(&self) -> f64;
+    /// Norm that normalises the residual, from the last `evaluate` (for
+    /// [`ResidualNorm::Total`] the reactions change with the iterate).
+    fn reference_norm(&self, norm: ResidualNorm) -> f64;
 }
 
 /// The residual history of a converged solve.
@@ -98,16 +138,18 @@ pub fn solve(
     let n = system.num_unknowns();
     let mut r = vec![0.0; n];
     let mut history = Vec::with_capacity(settings.max_iterations.min(64) + 1);
-    let scale = system.reference_norm();
-    let scale = if scale > 0.0 && scale.is_finite() {
-        scale
-    } else {
-        1.0
+    let scale = |system: &dyn NonlinearSystem| {
+        let s = system.reference_norm(settings.residual_norm);
+        if s > 0.0 && s.is_finite() {
+            s
+        } else {
+            1.0
+        }
     };
     if let Err(f) = system.evaluate(u, &mut r) {
         return Err((f, history));
     }
-    let mut res = norm(&r) / scale;
+    let mut res = norm(&r) / scale(system);
     if !res.is_finite() {
         return Err((StepFailure::NonFinite { iteration: 0 }, history));
     }
@@ -117,6 +159,9 @@ pub fn solve(
     for it in 1..=settings.max_iterations {
         if res <= settings.tolerance {
             return Ok(NewtonReport { residuals: history });
+        }
+        if let Some(stall) = detect_stall(&history, settings.tolerance) {
+            return Err((stall, history));
         }
         // K δ = −r, eq (22), with the tangent of the last evaluated (accepted) state.
         for (d, ri) in delta.iter_mut().zip(&r) {
@@ -135,7 +180,7 @@ pub fn solve(
             let last_try = !settings.line_search || halvings == MAX_HALVINGS;
             match system.evaluate(&trial, &mut r) {
                 Ok(()) => {
-                    let res_t = norm(&r) / scale;
+                    let res_t = norm(&r) / scale(system);
                     if res_t.is_finite() && (last_try || res_t < (1.0 - 1e-4 * alpha) * res) {
                         u.copy_from_slice(&trial);
                         res = res_t;
@@ -159,6 +204,9 @@ pub fn solve(
     if res <= settings.tolerance {
         return Ok(NewtonReport { residuals: history });
     }
+    if let Some(stall) = detect_stall(&history, settings.tolerance) {
+        return Err((stall, history));
+    }
     Err((
         StepFailure::NotConverged {
             iterations: settings.max_iterations,
@@ -166,6 +214,36 @@ pub fn solve(
         },
         history,
     ))
+}
+
+/// Iterations in a row without halving the best residual that make a stall.
+pub const STALL_WINDOW: usize = 3;
+
+/// Residuals (normalised) below which a stall is read as the round-off floor: Newton has
+/// already converged quadratically this far and the next decade is lost to cancellation in
+/// `f_int − f_ext` (the floor grows like the condition number of the tangent).
+pub const ROUND_OFF_REGION: f64 = 1e-3;
+
+/// A stall: the best residual reached is below [`ROUND_OFF_REGION`] and above `tolerance`,
+/// and the last [`STALL_WINDOW`] iterations have not halved it. The floor estimate is the
+/// median of the stalled residuals (the level round-off keeps returning to).
+fn detect_stall(history: &[f64], tolerance: f64) -> Option<StepFailure> {
+    if history.len() < STALL_WINDOW + 2 {
+        return None;
+    }
+    let (head, window) = history.split_at(history.len() - STALL_WINDOW);
+    let best_before = head.iter().copied().fold(f64::INFINITY, f64::min);
+    if !(best_before <= ROUND_OFF_REGION) || window.iter().any(|&r| r <= 0.5 * best_before) {
+        return None;
+    }
+    let mut w: Vec<f64> = window.to_vec();
+    w.sort_by(f64::total_cmp);
+    Some(StepFailure::Stalled {
+        iterations: history.len() - 1,
+        floor: w[w.len() / 2],
+        best: best_before.min(w[0]),
+        tolerance,
+    })
 }
 
 /// Most step halvings of the backtracking line search.
@@ -244,26 +322,143 @@ pub fn check_quadratic(
     Ok(out)
 }
 
+/// One attempt at an increment inside a load step that needed cutbacks.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SubStep {
+    /// Load factor the attempt aimed at.
+    pub load_factor: f64,
+    /// Did it converge (and so commit)?
+    pub converged: bool,
+    /// Why it failed (and the increment was cut), if it did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failure: Option<String>,
+    /// Its normalised residual history.
+    pub residuals: Vec<f64>,
+}
+
 /// What one converged load step did.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StepReport {
     /// Load step number, from 1.
     pub step: usize,
     pub load_factor: f64,
+    /// The Newton solve that reached `load_factor` (the last sub-step).
     pub newton: NewtonReport,
     /// Grid nodes constrained by the weak-node treatment in this step (0 for FEM).
     #[serde(default)]
     pub weak_nodes: usize,
+    /// Every attempt of a step that needed cutbacks, in order (empty when the nominal
+    /// increment converged at once).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub substeps: Vec<SubStep>,
 }
 
-/// A solver that advances through a fixed number of proportional load steps.
+impl StepReport {
+    /// Failed attempts (increments cut) in this step.
+    pub fn cutbacks(&self) -> usize {
+        self.substeps.iter().filter(|s| !s.converged).count()
+    }
+}
+
+/// One converged increment, as a solver reports it to the load stepping.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Increment {
+    pub newton: NewtonReport,
+    /// Grid nodes constrained by the weak-node treatment (0 for FEM).
+    pub weak_nodes: usize,
+}
+
+/// A solver that advances through proportional load steps, cutting a failing increment
+/// (adaptive load stepping, [`NewtonSettings::max_cutbacks`]).
+///
+/// The nominal load levels `k / load_steps` are always hit exactly: a step that fails is
+/// rolled back to the last committed state and retried with half the increment, down to
+/// 2^-max_cutbacks of the nominal one; after a converged sub-step the increment doubles
+/// again (never beyond the nominal one, never past the step's level). A step still failing
+/// at the floor is the analysis' failure.
 pub trait LoadStepping {
-    /// Solve and commit the next load step.
-    fn step(&mut self) -> Result<StepReport, SolveError>;
+    /// Solve one increment from the committed state to the total load factor `load_factor`
+    /// and commit it on success. On failure nothing is committed: the solver is as before.
+    fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)>;
     /// Load steps completed so far.
     fn steps_done(&self) -> usize;
+    /// Record that nominal step `n` is complete.
+    fn set_steps_done(&mut self, n: usize);
     /// Total number of load steps.
     fn load_steps(&self) -> usize;
+    /// The Newton settings (for the cutback limit).
+    fn newton_settings(&self) -> &NewtonSettings;
+
+    /// Solve and commit the next nominal load step, with cutbacks where needed.
+    fn step(&mut self) -> Result<StepReport, SolveError> {
+        let n = self.steps_done();
+        let total = self.load_steps();
+        let step = n + 1;
+        let target = step as f64 / total as f64;
+        let nominal = 1.0 / total as f64;
+        let max_cuts = self.newton_settings().max_cutbacks;
+        let floor = nominal / f64::powi(2.0, max_cuts as i32);
+        let mut current = n as f64 / total as f64;
+        let mut increment = nominal;
+        let mut substeps: Vec<SubStep> = Vec::new();
+        loop {
+            // Snap onto the step's level when within round-off of it.
+            let to = if current + increment >= target - 1e-9 * nominal {
+                target
+            } else {
+                current + increment
+            };
+            match self.advance(to) {
+                Ok(inc) => {
+                    if to == target {
+                        if !substeps.is_empty() {
+                            substeps.push(SubStep {
+                                load_factor: to,
+                                converged: true,
+                                failure: None,
+                                residuals: inc.newton.residuals.clone(),
+                            });
+                        }
+                        self.set_steps_done(step);
+                        return Ok(StepReport {
+                            step,
+                            load_factor: target,
+                            newton: inc.newton,
+                            weak_nodes: inc.weak_nodes,
+                            substeps,
+                        });
+                    }
+                    substeps.push(SubStep {
+                        load_factor: to,
+                        converged: true,
+                        failure: None,
+                        residuals: inc.newton.residuals,
+                    });
+                    current = to;
+                    increment = (2.0 * increment).min(nominal);
+                }
+                Err((failure, residuals)) => {
+                    let half = 0.5 * (to - current);
+                    if half < floor * (1.0 - 1e-9) {
+                        return Err(SolveError {
+                            step,
+                            failure,
+                            residuals,
+                            attempts: substeps.len() + 1,
+                            load_factor: to,
+                        });
+                    }
+                    substeps.push(SubStep {
+                        load_factor: to,
+                        converged: false,
+                        failure: Some(failure.to_string()),
+                        residuals,
+                    });
+                    increment = half;
+                }
+            }
+        }
+    }
 
     /// Run all remaining load steps. On failure returns the reports of the converged steps
     /// and the error; the solver then holds the last converged state.

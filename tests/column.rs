@@ -45,6 +45,7 @@ fn newton_converges_quadratically_on_the_column() {
                     tolerance: 1e-11,
                     max_iterations: 30,
                     line_search: false,
+                    ..Default::default()
                 },
                 ..table1_spec(256)
             };
@@ -233,6 +234,7 @@ fn bad_column_input_names_the_field() {
                     tolerance: f64::NAN,
                     max_iterations: 5,
                     line_search: false,
+                    ..Default::default()
                 },
                 ..Default::default()
             },
@@ -244,6 +246,7 @@ fn bad_column_input_names_the_field() {
                     tolerance: 1e-9,
                     max_iterations: 0,
                     line_search: false,
+                    ..Default::default()
                 },
                 ..Default::default()
             },
@@ -275,6 +278,7 @@ fn points_outside_grid_rejected_and_divergence_recorded() {
             tolerance: 1e-12,
             max_iterations: 1,
             line_search: false,
+            ..Default::default()
         },
         ..table1_spec(16)
     };

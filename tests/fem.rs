@@ -188,6 +188,7 @@ fn fem_quadratic_reproduces_linear_strain_small_strain() {
                 tolerance: 1e-10,
                 max_iterations: 10,
                 line_search: false,
+                ..Default::default()
             },
             load_steps: 2,
         };

@@ -614,6 +614,7 @@ fn cantilever_tip(nx: usize, ny: usize, p: f64, clamp_all: bool) -> f64 {
             tolerance: 1e-6,
             max_iterations: 10,
             line_search: false,
+            ..Default::default()
         },
         ..PlaneFemSettings::default()
     };

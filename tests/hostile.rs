@@ -435,6 +435,7 @@ fn newton() -> impl Strategy<Value = NewtonSettings> {
             tolerance,
             max_iterations,
             line_search,
+            ..Default::default()
         })
 }
 
@@ -474,7 +475,7 @@ proptest! {
     ) {
         let spec = ColumnSpec {
             length, young_modulus, poisson_ratio, density, weight, elements, points_per_cell,
-            load_steps, newton, yield_stress, gauss_points,
+            load_steps, newton, yield_stress, gauss_points, ghost: Default::default(),
         };
         let ok = no_panic("ColumnSpec::validate", || spec.validate())?.is_some();
         let small = elements * points_per_cell <= 64 && load_steps <= 3 && newton.max_iterations <= 40;

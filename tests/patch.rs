@@ -30,6 +30,7 @@ fn patch<const D: usize>(
         weak_node_treatment: Default::default(),
         volume_update: Default::default(),
         linear_solver: Default::default(),
+        ghost: Default::default(),
     };
     let loads = Loads {
         gravity: SVector::<f64, D>::zeros(),
@@ -62,6 +63,8 @@ fn patch<const D: usize>(
         matrix: &mut matrix,
         trials: &mut trials,
         du_nodal: &mut du,
+        ghost: None,
+        fixed_forces: &mut Vec::new(),
     };
     let mut r = vec![0.0; dofs.len()];
     sys.evaluate(&u, &mut r).unwrap();

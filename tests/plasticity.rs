@@ -190,6 +190,7 @@ fn newton_converges_quadratically_on_the_plastic_column() {
                 tolerance: 1e-10,
                 max_iterations: 30,
                 line_search: false,
+                ..Default::default()
             },
             ..plastic_spec(w, 256)
         };

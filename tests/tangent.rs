@@ -89,12 +89,29 @@ fn constitutive_tangent_matches_central_differences() {
 /// Compare the assembled tangent with central differences of the residual at `u0`.
 /// Returns max |K − K_fd| / max |K|.
 fn global_tangent_error<const D: usize>(solver: &mut MpmSolver<D>, u0_scale: f64, seed: u64) -> f64 {
+    tangent_error_with(solver, u0_scale, seed, false)
+}
+
+/// [`global_tangent_error`]; `wrong_ghost` leaves the ghost term out of the tangent (but not
+/// the residual): the deliberately wrong variant the check must catch.
+fn tangent_error_with<const D: usize>(
+    solver: &mut MpmSolver<D>,
+    u0_scale: f64,
+    seed: u64,
+    wrong_ghost: bool,
+) -> f64 {
     solver.build_supports().unwrap();
+    solver.build_ghost();
+    let ghost = solver.settings.ghost.is_on().then(|| solver.ghost().clone());
     let table = solver.supports().clone();
     let dofs = DofMap::build(solver.grid.num_nodes(), &table, &solver.fixed, &[]);
     let n = dofs.len();
     let mut matrix = SparseSystem::default();
-    matrix.set_pattern(dofs.pattern(&table));
+    let mut columns = dofs.pattern(&table);
+    if let Some(g) = &ghost {
+        g.add_pattern(&dofs, &mut columns);
+    }
+    matrix.set_pattern(columns);
     let f_ext = vec![0.0; n];
     let mut trials = Vec::new();
     let mut du = Vec::new();
@@ -109,10 +126,17 @@ fn global_tangent_error<const D: usize>(solver: &mut MpmSolver<D>, u0_scale: f64
         matrix: &mut matrix,
         trials: &mut trials,
         du_nodal: &mut du,
+        ghost: ghost.as_ref(),
+        fixed_forces: &mut Vec::new(),
     };
     let mut r0 = vec![0.0; n];
     sys.evaluate(&u0, &mut r0).unwrap();
+    let ghost_ref = sys.ghost;
+    if wrong_ghost {
+        sys.ghost = None;
+    }
     sys.assemble_tangent();
+    sys.ghost = ghost_ref;
     let k: Vec<Vec<f64>> = (0..n)
         .map(|i| (0..n).map(|j| sys.matrix.get(i, j)).collect())
         .collect();
@@ -160,9 +184,21 @@ fn gimp_1d_global_tangent_matches_central_differences() {
 /// (F_n = R U), evaluated at a random trial increment.
 #[test]
 fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() {
-    for basis in [Basis::Gimp, Basis::Mpm] {
+    use igimp::ghost::{GhostFaces, GhostSettings};
+    let off = GhostSettings::default();
+    let all = GhostSettings { gamma: 0.5, faces: GhostFaces::All };
+    let cut = GhostSettings { gamma: 0.5, faces: GhostFaces::Cut };
+    // (basis, ghost, upper corner of the material): [3.5, 2.5] leaves half-filled cells.
+    let variants = [
+        (Basis::Gimp, off, [4.0, 3.0]),
+        (Basis::Mpm, off, [4.0, 3.0]),
+        (Basis::Gimp, all, [4.0, 3.0]),
+        (Basis::Gimp, cut, [3.5, 2.5]),
+        (Basis::Mpm, cut, [3.5, 2.5]),
+    ];
+    for (basis, ghost, upper) in variants {
         let grid = Grid::try_new([0.0, 0.0], [1.0, 1.0], [5, 5]).unwrap();
-        let mut points = MaterialPoints::fill_box(&grid, [1.0, 1.0], [4.0, 3.0], [2, 2], 10.0).unwrap();
+        let mut points = MaterialPoints::fill_box(&grid, [1.0, 1.0], upper, [2, 2], 10.0).unwrap();
         let model = LinearElastic::try_new(1e5, 0.3).unwrap();
         let th: f64 = 0.6;
         let r = Matrix2::new(th.cos(), -th.sin(), th.sin(), th.cos());
@@ -193,6 +229,7 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
             weak_node_treatment: Default::default(),
             volume_update: Default::default(),
             linear_solver: Default::default(),
+            ghost,
         };
         let loads = Loads {
             gravity: SVector::<f64, 2>::zeros(),
@@ -200,7 +237,12 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
         };
         let mut solver = MpmSolver::try_new(grid, points, Box::new(model), fixed, loads, settings).unwrap();
         let err = global_tangent_error(&mut solver, 0.05, 22);
-        assert!(err < 1e-6, "{basis:?}: relative tangent error {err:e}");
+        assert!(err < 1e-6, "{basis:?} {ghost:?}: relative tangent error {err:e}");
+        if ghost.is_on() {
+            assert!(solver.ghost().num_faces() > 0, "{basis:?} {ghost:?}: no ghost face");
+            let wrong = tangent_error_with(&mut solver, 0.05, 22, true);
+            assert!(wrong > 1e-3, "{basis:?} {ghost:?}: tangent without the ghost term passes ({wrong:e})");
+        }
     }
 }
 

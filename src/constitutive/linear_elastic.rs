@@ -75,4 +75,8 @@ impl ConstitutiveModel for LinearElastic {
     fn tangent(&self, _eps_trial: &Matrix3<f64>, _committed: &MaterialState) -> Tensor4 {
         self.d
     }
+
+    fn young_modulus(&self) -> f64 {
+        self.young_modulus
+    }
 }

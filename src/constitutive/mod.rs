@@ -69,6 +69,10 @@ pub trait ConstitutiveModel: Send + Sync {
     /// arguments. Separate from the update so that residual-only evaluations (and the stored
     /// trial states, 648 bytes less per point) do not carry it.
     fn tangent(&self, eps_trial: &Matrix3<f64>, committed: &MaterialState) -> Tensor4;
+
+    /// The elastic Young's modulus E: the stiffness scale of stabilisation terms
+    /// ([`crate::ghost`]), which must not depend on the state so that they stay quadratic.
+    fn young_modulus(&self) -> f64;
 }
 
 /// The models igimp ships, selectable from study files.

@@ -108,4 +108,8 @@ impl ConstitutiveModel for VonMises {
         let i_dev = identity_sym() - identity_outer() * (1.0 / 3.0);
         identity_outer() * k + (i_dev - outer(&n, &n)) * (2.0 * g * ratio)
     }
+
+    fn young_modulus(&self) -> f64 {
+        self.young_modulus
+    }
 }

@@ -58,12 +58,12 @@ pub use updated_lagrangian::{validate_stepping, FemMesh, GaussPoints, MAX_LOAD_S
 
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
-use crate::error::{require_finite, InputError, SolveError, StepFailure};
-use crate::newton::{LoadStepping, NewtonSettings, StepReport};
+use crate::error::{require_finite, InputError, StepFailure};
+use crate::newton::{Increment, LoadStepping, NewtonSettings};
 use crate::problems::column::{ColumnObserver, ColumnOutcome, ColumnSpec, ColumnState, PointRecord};
 use crate::quadrature::GaussRule;
 use nalgebra::SVector;
-use updated_lagrangian::{fem_step, fem_step_system, UlCore};
+use updated_lagrangian::{fem_advance, fem_step_system, UlCore};
 
 /// Settings of a [`LineFem`] analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -211,16 +211,22 @@ impl LineFem {
 }
 
 impl LoadStepping for LineFem {
-    fn step(&mut self) -> Result<StepReport, SolveError> {
-        fem_step(
+    fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
+        fem_advance(
             &mut self.core,
             &mut self.mesh,
             &mut self.gauss,
             SVector::<f64, 1>::new(self.loads.gravity),
             &self.loads.nodal_forces,
             &self.settings.newton,
-            self.settings.load_steps,
+            load_factor,
         )
+    }
+    fn set_steps_done(&mut self, n: usize) {
+        self.core.step = n;
+    }
+    fn newton_settings(&self) -> &NewtonSettings {
+        &self.settings.newton
     }
     fn steps_done(&self) -> usize {
         self.core.step

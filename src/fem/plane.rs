@@ -3,12 +3,12 @@
 //! and 3×3). Plane strain comes from the shared kinematics, which keep F₃₃ = 1.
 
 use super::quad::{PlaneMesh, QuadElement};
-use super::updated_lagrangian::{fem_step, fem_step_system, validate_stepping, FemMesh, GaussPoints, UlCore};
+use super::updated_lagrangian::{fem_advance, fem_step_system, validate_stepping, FemMesh, GaussPoints, UlCore};
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
-use crate::error::{require_finite, InputError, SolveError, StepFailure};
+use crate::error::{require_finite, InputError, StepFailure};
 use crate::linear::LinearSolver;
-use crate::newton::{LoadStepping, NewtonSettings, StepReport};
+use crate::newton::{Increment, LoadStepping, NewtonSettings};
 use nalgebra::{Matrix3, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -221,16 +221,22 @@ impl PlaneFem {
 }
 
 impl LoadStepping for PlaneFem {
-    fn step(&mut self) -> Result<StepReport, SolveError> {
-        fem_step(
+    fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
+        fem_advance(
             &mut self.core,
             &mut self.mesh,
             &mut self.gauss,
             self.loads.gravity,
             &self.dof_forces,
             &self.settings.newton,
-            self.settings.load_steps,
+            load_factor,
         )
+    }
+    fn set_steps_done(&mut self, n: usize) {
+        self.core.step = n;
+    }
+    fn newton_settings(&self) -> &NewtonSettings {
+        &self.settings.newton
     }
     fn steps_done(&self) -> usize {
         self.core.step

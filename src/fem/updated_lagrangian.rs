@@ -6,9 +6,9 @@
 
 use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
 use crate::constitutive::ConstitutiveModel;
-use crate::error::{require_count, InputError, SolveError, StepFailure};
+use crate::error::{require_count, InputError, StepFailure};
 use crate::kinematics::PointState;
-use crate::newton::{NewtonSettings, StepReport};
+use crate::newton::{Increment, NewtonSettings};
 use nalgebra::SVector;
 
 /// Most load steps an analysis may ask for.
@@ -131,43 +131,33 @@ impl<const D: usize> UlCore<D> {
             ties: &[],
             point_forces: &forces,
             nodal_forces: &nodal,
+            ghost: None,
         };
         f(&mut self.work, &input)
     }
 
-    /// Solve and commit load step `step + 1` of `load_steps` at load factor step/load_steps
-    /// (the ramp of the material point solver). `build_supports` fills the support table on
-    /// the start-of-step mesh; on convergence the Gauss point states are committed, and the
-    /// caller moves its nodes by the converged increment `work.du_nodal` (node·D + axis).
-    pub fn step(
+    /// Solve and commit one increment to the total load factor `load_factor` (the ramp of
+    /// the material point solver). `build_supports` fills the support table on the
+    /// start-of-step mesh; on convergence the Gauss point states are committed, and the
+    /// caller moves its nodes by the converged increment `work.du_nodal` (node·D + axis). On
+    /// failure nothing is committed.
+    pub fn advance(
         &mut self,
         newton: &NewtonSettings,
-        load_steps: usize,
+        load_factor: f64,
         states: &mut [PointState],
         num_nodes: usize,
         loads: &FullLoads<'_, D>,
         build_supports: impl FnOnce(&mut SupportTable<D>) -> Result<(), StepFailure>,
-    ) -> Result<StepReport, SolveError> {
-        let step = self.step + 1;
-        let fail = |failure, residuals| SolveError {
-            step,
-            failure,
-            residuals,
-        };
-        let load_factor = step as f64 / load_steps as f64;
-        build_supports(&mut self.work.table).map_err(|f| fail(f, vec![]))?;
-        let report = self
-            .with_input(states, num_nodes, loads, load_factor, |work, input| {
-                work.solve(input, newton)
-            })
-            .map_err(|(f, r)| fail(f, r))?;
+    ) -> Result<Increment, (StepFailure, Vec<f64>)> {
+        build_supports(&mut self.work.table).map_err(|f| (f, vec![]))?;
+        let report = self.with_input(states, num_nodes, loads, load_factor, |work, input| {
+            work.solve(input, newton)
+        })?;
         for (state, new) in states.iter_mut().zip(self.work.committed_states()) {
             *state = new;
         }
-        self.step = step;
-        Ok(StepReport {
-            step,
-            load_factor,
+        Ok(Increment {
             newton: report,
             weak_nodes: 0,
         })
@@ -193,19 +183,19 @@ pub trait FemMesh<const D: usize> {
     fn move_nodes(&mut self, du: &[f64]);
 }
 
-/// One load step of an updated-Lagrangian FEM solver on `mesh` (the shared body of
-/// `LoadStepping::step`): supports on the start-of-step mesh, Newton, commit of the Gauss
+/// One increment of an updated-Lagrangian FEM solver on `mesh` (the shared body of
+/// `LoadStepping::advance`): supports on the start-of-step mesh, Newton, commit of the Gauss
 /// point states, and the nodes moved by the converged increment, which makes the converged
 /// configuration the next reference.
-pub(crate) fn fem_step<const D: usize, M: FemMesh<D>>(
+pub(crate) fn fem_advance<const D: usize, M: FemMesh<D>>(
     core: &mut UlCore<D>,
     mesh: &mut M,
     gauss: &mut GaussPoints<M::Local>,
     gravity: SVector<f64, D>,
     dof_forces: &[(usize, f64)],
     newton: &NewtonSettings,
-    load_steps: usize,
-) -> Result<StepReport, SolveError> {
+    load_factor: f64,
+) -> Result<Increment, (StepFailure, Vec<f64>)> {
     let loads = FullLoads {
         gravity,
         mass: &gauss.mass,
@@ -213,16 +203,16 @@ pub(crate) fn fem_step<const D: usize, M: FemMesh<D>>(
     };
     let (elements, xis) = (&gauss.element, &gauss.xi);
     let m: &M = mesh;
-    let report = core.step(
+    let inc = core.advance(
         newton,
-        load_steps,
+        load_factor,
         &mut gauss.state,
         m.num_nodes(),
         &loads,
         |table| m.fill_supports(elements, xis, table),
     )?;
     mesh.move_nodes(&core.work.du_nodal);
-    Ok(report)
+    Ok(inc)
 }
 
 /// The nonlinear system of a load step at `load_factor` on the current mesh and committed

@@ -11,6 +11,7 @@ use crate::basis::Basis;
 use crate::constitutive::LinearElastic;
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::grid::Grid;
+use crate::ghost::GhostSettings;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, VolumeUpdate, WeakNodeTreatment};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::particles::MaterialPoints;
@@ -49,6 +50,9 @@ pub struct CantileverSpec {
     /// F-diagonal run completes although its domains shrink to a fraction of their size.
     #[serde(default)]
     pub volume_update: VolumeUpdate,
+    /// Ghost penalty of nearly empty cells ([`crate::ghost`]).
+    #[serde(default)]
+    pub ghost: GhostSettings,
 }
 
 impl Default for CantileverSpec {
@@ -69,6 +73,7 @@ impl Default for CantileverSpec {
             weak_node_tolerance: 2e-2,
             weak_node_treatment: WeakNodeTreatment::Tie,
             volume_update: VolumeUpdate::DomainProduct,
+            ghost: GhostSettings::default(),
         }
     }
 }
@@ -169,6 +174,7 @@ impl CantileverSpec {
             weak_node_treatment: self.weak_node_treatment,
             volume_update: self.volume_update,
             linear_solver: Default::default(),
+            ghost: self.ghost,
         };
         let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
         Ok((

@@ -8,6 +8,7 @@ use crate::basis::Basis;
 use crate::constitutive::{lame, ConstitutiveModel, LinearElastic};
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::grid::Grid;
+use crate::ghost::GhostSettings;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::norms;
@@ -294,6 +295,14 @@ pub struct ColumnSpec {
     /// quadratic elements, as in the paper). Not used by MPM/GIMP.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gauss_points: Option<usize>,
+    /// Ghost penalty (MPM/GIMP only; off by default: the column has no nearly empty cells,
+    /// but one point per cell needs it on every face).
+    #[serde(default, skip_serializing_if = "is_off")]
+    pub ghost: GhostSettings,
+}
+
+fn is_off(g: &GhostSettings) -> bool {
+    !g.is_on()
 }
 
 impl Default for ColumnSpec {
@@ -310,6 +319,7 @@ impl Default for ColumnSpec {
             newton: NewtonSettings::default(),
             yield_stress: None,
             gauss_points: None,
+            ghost: GhostSettings::default(),
         }
     }
 }
@@ -391,6 +401,7 @@ impl ColumnSpec {
             weak_node_treatment: Default::default(),
             volume_update: Default::default(),
             linear_solver: Default::default(),
+            ghost: self.ghost,
         };
         MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, settings)
     }

@@ -12,6 +12,7 @@ use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
+use crate::ghost::GhostSettings;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, WeakNodeTreatment};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::particles::MaterialPoints;
@@ -49,6 +50,9 @@ pub struct CompactionSpec {
     /// Sparse factorisation; LDLᵀ suits this symmetric tangent (LU fallback).
     #[serde(default)]
     pub linear_solver: LinearSolver,
+    /// Ghost penalty of nearly empty cells ([`crate::ghost`]).
+    #[serde(default)]
+    pub ghost: GhostSettings,
 }
 
 impl Default for CompactionSpec {
@@ -70,6 +74,7 @@ impl Default for CompactionSpec {
             basis: Basis::Gimp,
             domain_update: DomainUpdate::Stretch,
             linear_solver: LinearSolver::Lu,
+            ghost: GhostSettings::default(),
         }
     }
 }
@@ -153,6 +158,7 @@ impl CompactionSpec {
             weak_node_treatment: self.weak_node_treatment,
             volume_update: Default::default(),
             linear_solver: self.linear_solver,
+            ghost: self.ghost,
         };
         MpmSolver::try_new(grid, points, self.model()?, fixed, loads, settings)
     }

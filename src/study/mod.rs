@@ -148,6 +148,14 @@ pub struct NewtonSection {
     /// Backtracking line search (default off: plain Newton as in the paper).
     #[serde(default)]
     pub line_search: bool,
+    /// `external` (‖f_ext‖ over the free dofs, the default) or `total` (‖f_ext + f_reaction‖
+    /// over all dofs, the paper's Tables 2–3).
+    #[serde(default)]
+    pub residual_norm: crate::newton::ResidualNorm,
+    /// Adaptive load stepping: most halvings of a failing increment (0..=20, default 6:
+    /// down to 1/64 of a load step; 0 = fixed steps).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_cutbacks: Option<u32>,
 }
 
 impl NewtonSection {
@@ -156,6 +164,8 @@ impl NewtonSection {
             tolerance: self.tolerance,
             max_iterations: self.max_iterations as usize,
             line_search: self.line_search,
+            residual_norm: self.residual_norm,
+            max_cutbacks: self.max_cutbacks.unwrap_or(crate::newton::DEFAULT_CUTBACKS),
         }
     }
 }

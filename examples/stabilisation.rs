@@ -1,0 +1,88 @@
+//! Stabilisation probe: `cargo run --release --example stabilisation -- <compaction|cantilever> [args]`.
+//! Prints the measure of each problem for one treatment per line, for quick sensitivity runs
+//! outside the studies (which record the same sweeps in results.json).
+//!
+//! compaction: h ppc treatment [yield]   (treatment: none | tie | ghost:<gamma>[:all])
+//! cantilever: treatment [update]        (update: stretch | f-diagonal)
+use igimp::ghost::{GhostFaces, GhostSettings};
+use igimp::mpm::{DomainUpdate, WeakNodeTreatment};
+use igimp::problems::{cantilever, compaction};
+
+fn treatment(s: &str) -> (f64, WeakNodeTreatment, GhostSettings) {
+    let mut g = GhostSettings::default();
+    match s {
+        "none" => (0.0, WeakNodeTreatment::Tie, g),
+        "tie" => (2e-2, WeakNodeTreatment::Tie, g),
+        "fix" => (2e-2, WeakNodeTreatment::Fix, g),
+        _ => {
+            let parts: Vec<&str> = s.split(':').collect();
+            assert_eq!(parts[0], "ghost", "treatment: none | tie | fix | ghost:<gamma>[:all]");
+            g.gamma = parts[1].parse().expect("gamma");
+            if parts.get(2) == Some(&"all") {
+                g.faces = GhostFaces::All;
+            }
+            (0.0, WeakNodeTreatment::Tie, g)
+        }
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let t = std::time::Instant::now();
+    match args.first().map(String::as_str) {
+        Some("compaction") => {
+            let (tol, tr, ghost) = treatment(&args[3]);
+            let spec = compaction::CompactionSpec {
+                element_size: args[1].parse().unwrap(),
+                points_per_cell: args[2].parse().unwrap(),
+                yield_stress: args.get(4).and_then(|s| s.parse().ok()),
+                weak_node_tolerance: tol,
+                weak_node_treatment: tr,
+                ghost,
+                linear_solver: igimp::linear::LinearSolver::Ldlt,
+                ..Default::default()
+            };
+            let o = compaction::solve_mpm(&spec).unwrap();
+            let cuts: usize = o.steps.iter().map(|s| s.cutbacks()).sum();
+            let its: usize = o.steps.iter().map(|s| s.newton.iterations()).sum();
+            println!(
+                "compaction h={} ppc={} {}: umax {:.6} steps {} cutbacks {cuts} its {its} fail {:?} {:.1}s",
+                args[1],
+                args[2],
+                args[3],
+                o.max_horizontal_displacement,
+                o.steps.len(),
+                o.failure.map(|f| f.to_string().chars().take(160).collect::<String>()),
+                t.elapsed().as_secs_f64()
+            );
+        }
+        Some("cantilever") => {
+            let (tol, tr, ghost) = treatment(&args[1]);
+            let spec = cantilever::CantileverSpec {
+                weak_node_tolerance: tol,
+                weak_node_treatment: tr,
+                ghost,
+                domain_update: if args.get(2).map(String::as_str) == Some("f-diagonal") {
+                    DomainUpdate::FDiagonal
+                } else {
+                    DomainUpdate::Stretch
+                },
+                ..Default::default()
+            };
+            let o = cantilever::solve_mpm(&spec, 1000).unwrap();
+            let e = o.end.last().unwrap();
+            let cuts: usize = o.steps.iter().map(|s| s.cutbacks()).sum();
+            println!(
+                "cantilever {} {:?}: u/L {:.5} v/L {:.5} steps {} cutbacks {cuts} fail {:?} {:.1}s",
+                args[1],
+                spec.domain_update,
+                e.u_over_l,
+                e.v_over_l,
+                o.steps.len(),
+                o.failure.map(|f| f.to_string().chars().take(160).collect::<String>()),
+                t.elapsed().as_secs_f64()
+            );
+        }
+        _ => eprintln!("usage: stabilisation compaction h ppc treatment [yield] | cantilever treatment [update]"),
+    }
+}
