@@ -16,7 +16,10 @@ fn treatment(s: &str) -> (f64, WeakNodeTreatment, GhostSettings) {
         "fix" => (2e-2, WeakNodeTreatment::Fix, g),
         _ => {
             let parts: Vec<&str> = s.split(':').collect();
-            assert_eq!(parts[0], "ghost", "treatment: none | tie | fix | ghost:<gamma>[:all]");
+            assert_eq!(
+                parts[0], "ghost",
+                "treatment: none | tie | fix | ghost:<gamma>[:all]"
+            );
             g.gamma = parts[1].parse().expect("gamma");
             if parts.get(2) == Some(&"all") {
                 g.faces = GhostFaces::All;
@@ -52,7 +55,8 @@ fn main() {
                 args[3],
                 o.max_horizontal_displacement,
                 o.steps.len(),
-                o.failure.map(|f| f.to_string().chars().take(160).collect::<String>()),
+                o.failure
+                    .map(|f| f.to_string().chars().take(160).collect::<String>()),
                 t.elapsed().as_secs_f64()
             );
         }
@@ -67,22 +71,42 @@ fn main() {
                 } else {
                     DomainUpdate::Stretch
                 },
+                element_size: args.get(3).and_then(|s| s.parse().ok()).unwrap_or(0.5),
                 ..Default::default()
             };
             let o = cantilever::solve_mpm(&spec, 1000).unwrap();
             let e = o.end.last().unwrap();
+            // Points one cell back from the loaded end (not loaded): the displacement of the
+            // beam away from the concentrated load.
+            let (s0, s1) = (&o.snapshots[0].domains, &o.snapshots.last().unwrap().domains);
+            let back: Vec<usize> = (0..s0.len())
+                .filter(|&p| (s0[p][0] - (spec.length - 0.5 - s0[p][2])).abs() < 1e-9)
+                .collect();
+            let (mut bu, mut bv) = (0.0, 0.0);
+            for &p in &back {
+                bu += (s1[p][0] - s0[p][0]) / spec.length / back.len() as f64;
+                bv += (s1[p][1] - s0[p][1]) / spec.length / back.len() as f64;
+            }
+            println!(
+                "  section at L - h: u/L {bu:.5} v/L {bv:.5} ({} points)",
+                back.len()
+            );
             let cuts: usize = o.steps.iter().map(|s| s.cutbacks()).sum();
             println!(
-                "cantilever {} {:?}: u/L {:.5} v/L {:.5} steps {} cutbacks {cuts} fail {:?} {:.1}s",
+                "cantilever h={} {} {:?}: u/L {:.5} v/L {:.5} steps {} cutbacks {cuts} fail {:?} {:.1}s",
+                spec.element_size,
                 args[1],
                 spec.domain_update,
                 e.u_over_l,
                 e.v_over_l,
                 o.steps.len(),
-                o.failure.map(|f| f.to_string().chars().take(160).collect::<String>()),
+                o.failure
+                    .map(|f| f.to_string().chars().take(160).collect::<String>()),
                 t.elapsed().as_secs_f64()
             );
         }
-        _ => eprintln!("usage: stabilisation compaction h ppc treatment [yield] | cantilever treatment [update]"),
+        _ => eprintln!(
+            "usage: stabilisation compaction h ppc treatment [yield] | cantilever treatment [update]"
+        ),
     }
 }

@@ -10,7 +10,7 @@ use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
 /// Most nodes a point may touch along one axis: a GIMP domain up to two elements long.
-pub const MAX_AXIS_NODES: usize = 4;
+pub const MAX_AXIS_NODES: usize = 5;
 
 /// Which weighting functions to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Hash)]

@@ -95,7 +95,9 @@ pub struct SolveError {
 
 fn cut_note(attempts: usize, load_factor: f64) -> String {
     if attempts > 1 {
-        format!(" (after {attempts} attempts, the last at load factor {load_factor:.6}, at the cutback floor)")
+        format!(
+            " (after {attempts} attempts, the last at load factor {load_factor:.6}, at the cutback floor)"
+        )
     } else {
         String::new()
     }

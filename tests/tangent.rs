@@ -186,8 +186,14 @@ fn gimp_1d_global_tangent_matches_central_differences() {
 fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() {
     use igimp::ghost::{GhostFaces, GhostSettings};
     let off = GhostSettings::default();
-    let all = GhostSettings { gamma: 0.5, faces: GhostFaces::All };
-    let cut = GhostSettings { gamma: 0.5, faces: GhostFaces::Cut };
+    let all = GhostSettings {
+        gamma: 0.5,
+        faces: GhostFaces::All,
+    };
+    let cut = GhostSettings {
+        gamma: 0.5,
+        faces: GhostFaces::Cut,
+    };
     // (basis, ghost, upper corner of the material): [3.5, 2.5] leaves half-filled cells.
     let variants = [
         (Basis::Gimp, off, [4.0, 3.0]),
@@ -239,9 +245,15 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
         let err = global_tangent_error(&mut solver, 0.05, 22);
         assert!(err < 1e-6, "{basis:?} {ghost:?}: relative tangent error {err:e}");
         if ghost.is_on() {
-            assert!(solver.ghost().num_faces() > 0, "{basis:?} {ghost:?}: no ghost face");
+            assert!(
+                solver.ghost().num_faces() > 0,
+                "{basis:?} {ghost:?}: no ghost face"
+            );
             let wrong = tangent_error_with(&mut solver, 0.05, 22, true);
-            assert!(wrong > 1e-3, "{basis:?} {ghost:?}: tangent without the ghost term passes ({wrong:e})");
+            assert!(
+                wrong > 1e-3,
+                "{basis:?} {ghost:?}: tangent without the ghost term passes ({wrong:e})"
+            );
         }
     }
 }

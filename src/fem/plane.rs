@@ -3,7 +3,9 @@
 //! and 3×3). Plane strain comes from the shared kinematics, which keep F₃₃ = 1.
 
 use super::quad::{PlaneMesh, QuadElement};
-use super::updated_lagrangian::{fem_advance, fem_step_system, validate_stepping, FemMesh, GaussPoints, UlCore};
+use super::updated_lagrangian::{
+    fem_advance, fem_step_system, validate_stepping, FemMesh, GaussPoints, UlCore,
+};
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_finite, InputError, StepFailure};

@@ -10,8 +10,8 @@
 use crate::basis::Basis;
 use crate::constitutive::LinearElastic;
 use crate::error::{require_count, require_positive, InputError, SolveError};
-use crate::grid::Grid;
 use crate::ghost::GhostSettings;
+use crate::grid::Grid;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, VolumeUpdate, WeakNodeTreatment};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::particles::MaterialPoints;
@@ -80,6 +80,7 @@ impl Default for CantileverSpec {
 
 impl CantileverSpec {
     pub fn validate(&self) -> Result<(), InputError> {
+        self.ghost.validate()?;
         require_positive("length", self.length)?;
         require_positive("depth", self.depth)?;
         require_positive("element_size", self.element_size)?;

@@ -7,8 +7,8 @@
 use crate::basis::Basis;
 use crate::constitutive::{lame, ConstitutiveModel, LinearElastic};
 use crate::error::{require_count, require_positive, InputError, SolveError};
-use crate::grid::Grid;
 use crate::ghost::GhostSettings;
+use crate::grid::Grid;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::norms;

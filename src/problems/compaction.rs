@@ -10,9 +10,9 @@
 use crate::basis::Basis;
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, require_positive, InputError, SolveError};
+use crate::ghost::GhostSettings;
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
-use crate::ghost::GhostSettings;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, WeakNodeTreatment};
 use crate::newton::{LoadStepping, NewtonSettings, StepReport};
 use crate::particles::MaterialPoints;
@@ -81,6 +81,7 @@ impl Default for CompactionSpec {
 
 impl CompactionSpec {
     pub fn validate(&self) -> Result<(), InputError> {
+        self.ghost.validate()?;
         require_positive("half_width", self.half_width)?;
         require_positive("height", self.height)?;
         require_positive("element_size", self.element_size)?;

@@ -13,8 +13,8 @@
 //! so the elastica's deflection (positive in the load direction) is stored as −v/L.
 
 use super::plane::{
-    self, check_at_most, failure_record, invalid, rejection, step_records, CheckRecord, IndexEntry,
-    PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
+    self, check_at_most, failure_record, invalid, rejection, step_records, CheckRecord, GhostSection,
+    IndexEntry, PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
 };
 use super::runner::{CaseStatus, FailureRecord, StepRecord};
 use super::{NewtonSection, StudyError, Tier};
@@ -67,6 +67,12 @@ pub struct CaseSection {
     /// iGIMP volume rule: `domain-product` (the paper's, the default) or `jacobian`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub volume_update: Option<VolumeUpdate>,
+    /// Ghost penalty factor γ of this case (0 = off); default: the `[ghost]` section's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ghost_gamma: Option<f64>,
+    /// Weak-node tolerance of this case (the tie/fix alternative); default: `[weak_nodes]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weak_node_tolerance: Option<f64>,
     /// Keep the domains every this many steps (and the last) for the figures; 0: none.
     #[serde(default)]
     pub snapshot_every: i64,
@@ -169,6 +175,7 @@ pub struct CantileverStudy {
     pub beam: BeamSection,
     pub newton: NewtonSection,
     pub weak_nodes: WeakNodeSection,
+    pub ghost: GhostSection,
     pub cases: Vec<CaseSection>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub depth_study: Option<DepthStudy>,
@@ -249,6 +256,15 @@ impl PlaneStudy for CantileverStudy {
         }
         if self.cases.is_empty() {
             return Err(invalid(file, "cases", "[]", "must list at least one case"));
+        }
+        self.ghost
+            .validate()
+            .map_err(|e| invalid(file, "ghost", e, "must be valid ghost settings"))?;
+        for (i, c) in self.cases.iter().enumerate() {
+            self.case_of(c)
+                .spec
+                .validate()
+                .map_err(|e| invalid(file, format!("cases[{i}]"), e, "must be a valid cantilever input"))?;
         }
         let known = |key: String, id: &str| -> Result<(), StudyError> {
             if self.cases.iter().any(|c| c.id == id) {
@@ -349,6 +365,7 @@ impl CantileverStudy {
             newton: self.newton.settings(),
             weak_node_tolerance: self.weak_nodes.tolerance,
             weak_node_treatment: self.weak_nodes.treatment,
+            ghost: self.ghost.settings(b.points_per_cell.max(1) as usize, None),
             ..CantileverSpec::default()
         }
     }
@@ -362,6 +379,8 @@ impl CantileverStudy {
                 CantileverSpec {
                     domain_update: c.domain_update.unwrap_or(base.domain_update),
                     volume_update: c.volume_update.unwrap_or(base.volume_update),
+                    ghost: self.ghost.settings(base.points_per_cell, c.ghost_gamma),
+                    weak_node_tolerance: c.weak_node_tolerance.unwrap_or(base.weak_node_tolerance),
                     ..base
                 }
             },

@@ -10,8 +10,8 @@
 //! captions then state.
 
 use super::plane::{
-    self, check_at_most, failure_record, invalid, rejection, step_records, CheckRecord, IndexEntry,
-    PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
+    self, check_at_most, failure_record, invalid, rejection, step_records, CheckRecord, GhostSection,
+    IndexEntry, PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
 };
 use super::runner::{CaseStatus, FailureRecord, StepRecord};
 use super::{NewtonSection, StudyError, Tier};
@@ -60,6 +60,8 @@ pub struct SweepQuick {
     pub points_per_cell: Option<Vec<i64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weak_node_tolerances: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ghost_gammas: Option<Vec<f64>>,
 }
 
 /// Methods × element sizes × points per cell × weak-node tolerances, one material.
@@ -78,8 +80,22 @@ pub struct CompactionSweep {
     /// Defaults to `[weak_nodes.tolerance]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weak_node_tolerances: Option<Vec<f64>>,
+    /// Ghost penalty factors γ (0 = off); defaults to the `[ghost]` section's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ghost_gammas: Option<Vec<f64>>,
     #[serde(default)]
     pub quick: SweepQuick,
+}
+
+/// The result does not depend on γ beyond `tolerance` (relative spread) for h ≤
+/// `max_element_size`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GhostSpreadExpectation {
+    pub sweep: String,
+    pub max_element_size: f64,
+    pub tolerance: f64,
+    pub source: String,
 }
 
 /// The Figure 17 normalisation.
@@ -187,6 +203,7 @@ pub struct CompactionStudy {
     pub block: BlockSection,
     pub newton: NewtonSection,
     pub weak_nodes: WeakNodeSection,
+    pub ghost: GhostSection,
     pub sweeps: Vec<CompactionSweep>,
     pub reference: ReferenceSection,
     #[serde(default)]
@@ -195,6 +212,10 @@ pub struct CompactionStudy {
     pub expect_convergence: Vec<ConvergenceExpectation>,
     #[serde(default)]
     pub expect_weak_node_spread: Vec<SpreadExpectation>,
+    /// Spread of the result over the ghost penalty factors of a sweep, per element size
+    /// (and points per cell), for h ≤ `max_element_size`.
+    #[serde(default)]
+    pub expect_ghost_spread: Vec<GhostSpreadExpectation>,
     #[serde(default)]
     pub paper_residuals: Vec<PaperResiduals>,
     #[serde(default)]
@@ -243,6 +264,9 @@ impl PlaneStudy for CompactionStudy {
                 "must be in 1..=1000",
             ));
         }
+        self.ghost
+            .validate()
+            .map_err(|e| invalid(file, "ghost", e, "must be valid ghost settings"))?;
         if self.sweeps.is_empty() {
             return Err(invalid(file, "sweeps", "[]", "must list at least one sweep"));
         }
@@ -304,6 +328,9 @@ impl PlaneStudy for CompactionStudy {
         sweep_known("reference.igimp_sweep".into(), &self.reference.igimp_sweep)?;
         for (i, e) in self.expect_deviation.iter().enumerate() {
             sweep_known(format!("expect_deviation[{i}].sweep"), &e.sweep)?;
+        }
+        for (i, e) in self.expect_ghost_spread.iter().enumerate() {
+            sweep_known(format!("expect_ghost_spread[{i}].sweep"), &e.sweep)?;
         }
         for (i, e) in self.expect_convergence.iter().enumerate() {
             sweep_known(format!("expect_convergence[{i}].sweep"), &e.sweep)?;
@@ -383,10 +410,20 @@ impl CompactionStudy {
                 s.weak_node_tolerances.as_ref().unwrap_or(&default_tol),
                 &q.weak_node_tolerances,
             ),
+            gammas: if quick { q.ghost_gammas.clone() } else { None }
+                .or_else(|| s.ghost_gammas.clone())
+                .map_or(vec![None], |g| g.into_iter().map(Some).collect()),
         })
     }
 
-    fn case_spec(&self, s: &CompactionSweep, h: f64, ppc: usize, tolerance: f64) -> CompactionSpec {
+    fn case_spec(
+        &self,
+        s: &CompactionSweep,
+        h: f64,
+        ppc: usize,
+        tolerance: f64,
+        gamma: Option<f64>,
+    ) -> CompactionSpec {
         let b = &self.block;
         CompactionSpec {
             half_width: b.half_width,
@@ -402,6 +439,7 @@ impl CompactionStudy {
             newton: self.newton.settings(),
             weak_node_tolerance: tolerance,
             weak_node_treatment: self.weak_nodes.treatment,
+            ghost: self.ghost.settings(ppc, gamma),
             ..CompactionSpec::default()
         }
     }
@@ -417,6 +455,9 @@ impl CompactionStudy {
             if spec.weak_node_tolerance != self.weak_nodes.tolerance {
                 id.push_str(&format!("-wn{}", number(spec.weak_node_tolerance)));
             }
+            if spec.ghost != self.ghost.settings(spec.points_per_cell, None) {
+                id.push_str(&format!("-g{}", number(spec.ghost.gamma)));
+            }
         }
         id
     }
@@ -424,20 +465,26 @@ impl CompactionStudy {
     fn sweep_cases(&self, s: &CompactionSweep, plan: &SweepPlan) -> Vec<CompactionCase> {
         let mut out = vec![];
         for &method in &plan.methods {
-            let (ppcs, tols) = if method.is_fem() {
-                (vec![2], vec![self.weak_nodes.tolerance])
+            let (ppcs, tols, gammas) = if method.is_fem() {
+                (vec![2], vec![self.weak_nodes.tolerance], vec![None])
             } else {
-                (plan.points_per_cell.clone(), plan.tolerances.clone())
+                (
+                    plan.points_per_cell.clone(),
+                    plan.tolerances.clone(),
+                    plan.gammas.clone(),
+                )
             };
             for &ppc in &ppcs {
                 for &h in &plan.element_sizes {
                     for &tol in &tols {
-                        let spec = self.case_spec(s, h, ppc.max(1) as usize, tol);
-                        out.push(CompactionCase {
-                            id: self.case_id(method, &spec),
-                            method,
-                            spec,
-                        });
+                        for &gamma in &gammas {
+                            let spec = self.case_spec(s, h, ppc.max(1) as usize, tol, gamma);
+                            out.push(CompactionCase {
+                                id: self.case_id(method, &spec),
+                                method,
+                                spec,
+                            });
+                        }
                     }
                 }
             }
@@ -466,6 +513,7 @@ struct SweepPlan {
     element_sizes: Vec<f64>,
     points_per_cell: Vec<i64>,
     tolerances: Vec<f64>,
+    gammas: Vec<Option<f64>>,
 }
 
 /// Result of one case.
@@ -479,6 +527,11 @@ pub struct CompactionRecord {
     pub points_per_cell: Option<usize>,
     pub yield_stress: Option<f64>,
     pub weak_node_tolerance: f64,
+    /// Ghost penalty factor γ of the case (0: off; FEM: 0).
+    pub ghost_gamma: f64,
+    /// Load steps that needed cutbacks, and the failed attempts in all.
+    pub steps_cut: usize,
+    pub cutbacks: usize,
     pub status: CaseStatus,
     pub failure: Option<FailureRecord>,
     /// Bottom-right point's horizontal displacement plus half its domain's growth (Figure 17);
@@ -542,11 +595,20 @@ impl CompactionResults {
     /// The iGIMP case of a sweep at (h, points per cell) with the study's weak-node tolerance.
     pub fn igimp_case(&self, sweep: &str, h: f64, ppc: usize) -> Option<&CompactionRecord> {
         self.sweep(sweep).into_iter().find(|c| {
-            c.method == PlaneMethod::Igimp
-                && c.h == h
-                && c.points_per_cell == Some(ppc)
-                && c.weak_node_tolerance == self.study.weak_nodes.tolerance
+            c.method == PlaneMethod::Igimp && c.h == h && c.points_per_cell == Some(ppc) && self.is_default(c)
         })
+    }
+
+    /// Does the case use the study's default treatment of nearly empty cells (weak-node
+    /// tolerance and ghost γ)? FEM cases always do.
+    pub fn is_default(&self, c: &CompactionRecord) -> bool {
+        match c.points_per_cell {
+            None => true,
+            Some(p) => {
+                c.weak_node_tolerance == self.study.weak_nodes.tolerance
+                    && c.ghost_gamma == self.study.ghost.settings(p, None).gamma
+            }
+        }
     }
 }
 
@@ -624,6 +686,9 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
         points_per_cell: (!case.method.is_fem()).then_some(s.points_per_cell),
         yield_stress: s.yield_stress,
         weak_node_tolerance: s.weak_node_tolerance,
+        ghost_gamma: if case.method.is_fem() { 0.0 } else { s.ghost.gamma },
+        steps_cut: 0,
+        cutbacks: 0,
         status: CaseStatus::Rejected,
         failure: None,
         max_horizontal_displacement: None,
@@ -654,6 +719,8 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
             rec.steps = step_records(&o.steps);
             rec.newton_iterations = o.steps.iter().map(|s| s.newton.iterations()).sum();
             rec.weak_nodes_treated = o.weak_nodes_treated;
+            rec.steps_cut = o.steps.iter().filter(|s| s.cutbacks() > 0).count();
+            rec.cutbacks = o.steps.iter().map(|s| s.cutbacks()).sum();
             rec.points = o.points;
             let u = o
                 .max_horizontal_displacement
@@ -797,10 +864,7 @@ fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
             let mut s: Vec<&CompactionRecord> = cases
                 .iter()
                 .copied()
-                .filter(|c| {
-                    c.points_per_cell == Some(p)
-                        && c.weak_node_tolerance == results.study.weak_nodes.tolerance
-                })
+                .filter(|c| c.points_per_cell == Some(p) && results.is_default(c))
                 .collect();
             s.sort_by(|a, b| b.h.total_cmp(&a.h));
             let d: Vec<f64> = s.iter().filter_map(|c| deviation(c)).collect();
@@ -851,6 +915,52 @@ fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
             &e.source,
         ));
     }
+    for e in &results.study.expect_ghost_spread {
+        let cases: Vec<&CompactionRecord> = igimp(&e.sweep)
+            .into_iter()
+            .filter(|c| c.ghost_gamma > 0.0 && c.h <= e.max_element_size)
+            .collect();
+        let keys: BTreeSet<(u64, Option<usize>)> =
+            cases.iter().map(|c| (c.h.to_bits(), c.points_per_cell)).collect();
+        let mut worst: Option<f64> = None;
+        let mut gammas: BTreeSet<u64> = BTreeSet::new();
+        let mut incomplete = 0;
+        for k in keys {
+            let group: Vec<&&CompactionRecord> = cases
+                .iter()
+                .filter(|c| (c.h.to_bits(), c.points_per_cell) == k)
+                .collect();
+            gammas.extend(group.iter().map(|c| c.ghost_gamma.to_bits()));
+            let u: Vec<f64> = group
+                .iter()
+                .filter_map(|c| c.max_horizontal_displacement)
+                .collect();
+            incomplete += group.len() - u.len();
+            if u.len() >= 2 {
+                let (lo, hi) = u
+                    .iter()
+                    .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+                let spread = (hi - lo) / lo.abs();
+                worst = Some(worst.map_or(spread, |w: f64| w.max(spread)));
+            }
+        }
+        let (g_lo, g_hi) = gammas
+            .iter()
+            .map(|&b| f64::from_bits(b))
+            .fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
+        out.push(check_at_most(
+            &format!("{}-ghost-spread", e.sweep),
+            format!(
+                "largest (max − min)/min of the displacement over ghost γ in [{}, {}] at one element size ≤ {} ({incomplete} case(s) not completed count as a failure)",
+                number(g_lo),
+                number(g_hi),
+                e.max_element_size
+            ),
+            if incomplete > 0 { Some(f64::INFINITY) } else { worst },
+            e.tolerance,
+            &e.source,
+        ));
+    }
     out
 }
 
@@ -874,6 +984,7 @@ pub fn run_study(study: &CompactionStudy, study_file: &str, tier: Tier) -> Compa
                 f.element_size?,
                 f.points_per_cell? as usize,
                 study.weak_nodes.tolerance,
+                None,
             );
             Some(study.case_id(PlaneMethod::Igimp, &spec))
         })
@@ -1019,13 +1130,12 @@ fn figure17_table(results: &CompactionResults) -> String {
             },
         }
     };
-    let tol = results.study.weak_nodes.tolerance;
     for h in hs {
         let _ = write!(s, "| {h} |");
         for p in &ppcs {
             let c = cases
                 .iter()
-                .find(|c| c.h == h && c.points_per_cell == Some(*p) && c.weak_node_tolerance == tol);
+                .find(|c| c.h == h && c.points_per_cell == Some(*p) && results.is_default(c));
             let _ = write!(s, " {} |", cell(c));
         }
         for m in &fems {
@@ -1043,7 +1153,7 @@ fn figure17_table(results: &CompactionResults) -> String {
 
 fn cases_table(results: &CompactionResults) -> String {
     let mut s = String::from(
-        "## All cases\n\n| case | method | h | points/cell | ρ_y | weak-node tol. | status | max horizontal u | weak nodes treated | Newton its/step |\n|---|---|---:|---:|---:|---:|---|---:|---:|---:|\n",
+        "## All cases\n\n| case | method | h | points/cell | ρ_y | weak-node tol. | ghost γ | status | max horizontal u | weak nodes treated | steps cut (attempts failed) | Newton its/step |\n|---|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|\n",
     );
     for c in &results.cases {
         let u = c
@@ -1056,16 +1166,26 @@ fn cases_table(results: &CompactionResults) -> String {
             .unwrap_or("—".into());
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             c.id,
             c.method.label(),
             c.h,
             c.points_per_cell.map_or("—".into(), |p| format!("{p}×{p}")),
             c.yield_stress.map_or("elastic".into(), number),
             c.weak_node_tolerance,
+            if c.method.is_fem() {
+                "—".into()
+            } else {
+                number(c.ghost_gamma)
+            },
             plane::status_word(c.status),
             u,
             c.weak_nodes_treated,
+            if c.steps_cut == 0 {
+                "0".into()
+            } else {
+                format!("{} ({})", c.steps_cut, c.cutbacks)
+            },
             if c.steps.is_empty() {
                 "—".into()
             } else {
@@ -1229,9 +1349,8 @@ fn render_figure(
                 return Ok(None);
             };
             let cases = results.sweep(&f.sweep);
-            let tol = results.study.weak_nodes.tolerance;
             let mut groups: BTreeMap<SeriesKey, Vec<(f64, f64)>> = BTreeMap::new();
-            for c in cases.iter().filter(|c| c.weak_node_tolerance == tol) {
+            for c in cases.iter().filter(|c| results.is_default(c)) {
                 if let Some(u) = c.max_horizontal_displacement {
                     groups
                         .entry((c.method, c.points_per_cell))

@@ -66,6 +66,45 @@ pub struct WeakNodeSection {
     pub treatment: WeakNodeTreatment,
 }
 
+/// Ghost stabilisation as written in a study file ([`crate::ghost`]): γ and the faces for
+/// two or more points per cell, and the settings for one point per cell (every face).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GhostSection {
+    /// Penalty factor γ for two or more points per cell (0 = off); in [0, 1000].
+    pub gamma: f64,
+    #[serde(default)]
+    pub faces: crate::ghost::GhostFaces,
+    /// Settings for one point per cell; default: the ones above.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub one_point_per_cell: Option<crate::ghost::GhostSettings>,
+    /// Where the defaults come from (the measurement that chose them).
+    pub source: String,
+}
+
+impl GhostSection {
+    /// The settings of a case with `ppc` points per cell; `gamma` (a sweep's value) replaces
+    /// the default γ.
+    pub fn settings(&self, ppc: usize, gamma: Option<f64>) -> crate::ghost::GhostSettings {
+        let mut g = match (ppc, self.one_point_per_cell) {
+            (1, Some(one)) => one,
+            _ => crate::ghost::GhostSettings {
+                gamma: self.gamma,
+                faces: self.faces,
+            },
+        };
+        if let Some(gamma) = gamma {
+            g.gamma = gamma;
+        }
+        g
+    }
+
+    pub fn validate(&self) -> Result<(), crate::error::InputError> {
+        self.settings(2, None).validate()?;
+        self.settings(1, None).validate()
+    }
+}
+
 /// A claim of the paper or the issue, checked against the results.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CheckRecord {
