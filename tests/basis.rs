@@ -217,7 +217,6 @@ fn points_outside_grid_and_degenerate_domains_are_errors() {
         (2.0, 0.0),
         (2.0, -0.1),
         (2.0, f64::NAN),
-        (2.0, 1.6),
         (f64::NAN, 0.1),
     ] {
         assert!(
@@ -228,6 +227,16 @@ fn points_outside_grid_and_degenerate_domains_are_errors() {
     for x in [-0.1, 4.1, f64::NAN] {
         assert!(Basis::Mpm.axis_weights(AXIS, x, 0.2, &mut ax).is_err(), "MPM {x}");
     }
+    // A domain may touch at most MAX_AXIS_NODES - 1 = 4 elements: [2.9, 7.1] touches 6.
+    let wide = igimp::basis::GridAxis { cells: 10, ..AXIS };
+    assert!(
+        Basis::Gimp.axis_weights(wide, 5.0, 2.1, &mut ax).is_err(),
+        "domain too long"
+    );
+    assert!(
+        Basis::Gimp.axis_weights(wide, 5.0, 1.4, &mut ax).is_ok(),
+        "3-element domain"
+    );
 }
 
 /// A domain protruding past the grid boundary (a rigid wall or symmetry plane) is cut at it,

@@ -142,17 +142,14 @@ fn compaction_figure17_within_one_percent_of_fem_reference() {
     }
 }
 
-/// Cases that cannot complete are recorded, not fatal: one point per cell (all h), the
-/// plastic block at h = 1/2, and untreated weak nodes at h = 1 fail with their load step, the
-/// reason and the residuals of the failing step.
+/// Cases that cannot complete are recorded, not fatal: the plastic block at h = 1/2 (it spreads
+/// into a pancake; det ΔF ≤ 0 at step 16 even with cutbacks) fails with its load step, the
+/// reason and the residuals of the failing step. Every Figure 17 case converges with the default ghost term, one point per
+/// cell included.
 #[test]
 fn compaction_failures_are_recorded_with_step_and_residuals() {
     let r = &quick().results;
-    for id in [
-        "igimp-elastic-h1-p1",
-        "igimp-vm12000-h0.5-p2",
-        "igimp-elastic-h1-p2-wn0",
-    ] {
+    for id in ["igimp-vm12000-h0.5-p2"] {
         let c = r.case(id).unwrap_or_else(|| panic!("case {id}"));
         assert_eq!(c.status, CaseStatus::Failed, "{id}");
         let f = c.failure.as_ref().unwrap();
@@ -162,6 +159,10 @@ fn compaction_failures_are_recorded_with_step_and_residuals() {
         );
         assert_eq!(c.steps.len(), f.step - 1, "{id}");
     }
+    for c in r.sweep("fig17") {
+        assert_eq!(c.status, CaseStatus::Converged, "{}: {:?}", c.id, c.failure);
+    }
+    assert!(r.case("igimp-elastic-h1-p1").is_some());
     let plastic = r.case("igimp-vm12000-h1-p2").unwrap();
     assert_eq!(plastic.status, CaseStatus::Converged);
     assert!(plastic.max_horizontal_displacement.unwrap() > 5.0);
