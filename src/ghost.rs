@@ -160,7 +160,7 @@ pub fn cell_fill<const D: usize>(
                 measure *= hi - lo;
             }
         }
-        if !(measure > 0.0) {
+        if measure.is_nan() || measure <= 0.0 {
             continue;
         }
         let share = v / (measure * cell_volume);

@@ -232,7 +232,7 @@ fn detect_stall(history: &[f64], tolerance: f64) -> Option<StepFailure> {
     }
     let (head, window) = history.split_at(history.len() - STALL_WINDOW);
     let best_before = head.iter().copied().fold(f64::INFINITY, f64::min);
-    if !(best_before <= ROUND_OFF_REGION) || window.iter().any(|&r| r <= 0.5 * best_before) {
+    if best_before.is_nan() || best_before > ROUND_OFF_REGION || window.iter().any(|&r| r <= 0.5 * best_before) {
         return None;
     }
     let mut w: Vec<f64> = window.to_vec();

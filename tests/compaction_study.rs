@@ -149,7 +149,8 @@ fn compaction_figure17_within_one_percent_of_fem_reference() {
 #[test]
 fn compaction_failures_are_recorded_with_step_and_residuals() {
     let r = &quick().results;
-    for id in ["igimp-vm12000-h0.5-p2"] {
+    {
+        let id = "igimp-vm12000-h0.5-p2";
         let c = r.case(id).unwrap_or_else(|| panic!("case {id}"));
         assert_eq!(c.status, CaseStatus::Failed, "{id}");
         let f = c.failure.as_ref().unwrap();
