@@ -123,8 +123,6 @@ pub struct MpmSolver<const D: usize> {
     step: usize,
     work: StepWorkspace<D>,
     ghost: GhostOperator<D>,
-    /// Total load factor of the committed state.
-    load_factor: f64,
 }
 
 impl<const D: usize> MpmSolver<D> {
@@ -184,7 +182,6 @@ impl<const D: usize> MpmSolver<D> {
             step: 0,
             work: StepWorkspace::default(),
             ghost: GhostOperator::default(),
-            load_factor: 0.0,
         })
     }
 
@@ -230,11 +227,6 @@ impl<const D: usize> MpmSolver<D> {
     /// is the only nodal displacement the solver has.
     pub fn step_increment(&self) -> &[f64] {
         &self.work.du_nodal
-    }
-
-    /// Total load factor of the committed state (the last converged increment).
-    pub fn load_factor(&self) -> f64 {
-        self.load_factor
     }
 
     /// The ghost operator of the last increment (faces, cell fill fractions).
@@ -406,7 +398,6 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
         self.work.matrix.set_solver(self.settings.linear_solver);
         let report = self.work.solve(&input, &self.settings.newton)?;
         self.commit().map_err(|f| (f, report.residuals.clone()))?;
-        self.load_factor = load_factor;
         Ok(Increment {
             newton: report,
             weak_nodes: weak.len(),

@@ -232,7 +232,10 @@ fn detect_stall(history: &[f64], tolerance: f64) -> Option<StepFailure> {
     }
     let (head, window) = history.split_at(history.len() - STALL_WINDOW);
     let best_before = head.iter().copied().fold(f64::INFINITY, f64::min);
-    if best_before.is_nan() || best_before > ROUND_OFF_REGION || window.iter().any(|&r| r <= 0.5 * best_before) {
+    if best_before.is_nan()
+        || best_before > ROUND_OFF_REGION
+        || window.iter().any(|&r| r <= 0.5 * best_before)
+    {
         return None;
     }
     let mut w: Vec<f64> = window.to_vec();
@@ -409,15 +412,17 @@ pub trait LoadStepping {
             };
             match self.advance(to) {
                 Ok(inc) => {
-                    if to == target {
-                        if !substeps.is_empty() {
-                            substeps.push(SubStep {
-                                load_factor: to,
-                                converged: true,
-                                failure: None,
-                                residuals: inc.newton.residuals.clone(),
-                            });
-                        }
+                    let done = to == target;
+                    // A step reached in one increment records no sub-steps.
+                    if !(done && substeps.is_empty()) {
+                        substeps.push(SubStep {
+                            load_factor: to,
+                            converged: true,
+                            failure: None,
+                            residuals: inc.newton.residuals.clone(),
+                        });
+                    }
+                    if done {
                         self.set_steps_done(step);
                         return Ok(StepReport {
                             step,
@@ -427,12 +432,6 @@ pub trait LoadStepping {
                             substeps,
                         });
                     }
-                    substeps.push(SubStep {
-                        load_factor: to,
-                        converged: true,
-                        failure: None,
-                        residuals: inc.newton.residuals,
-                    });
                     current = to;
                     increment = (2.0 * increment).min(nominal);
                 }

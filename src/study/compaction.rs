@@ -899,11 +899,7 @@ fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
                 .filter(|c| c.h.to_bits() == h)
                 .filter_map(|c| c.max_horizontal_displacement)
                 .collect();
-            if u.len() >= 2 {
-                let (lo, hi) = u
-                    .iter()
-                    .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-                let spread = (hi - lo) / lo.abs();
+            if let Some(spread) = relative_spread(&u) {
                 worst = Some(worst.map_or(spread, |w: f64| w.max(spread)));
             }
         }
@@ -936,11 +932,7 @@ fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
                 .filter_map(|c| c.max_horizontal_displacement)
                 .collect();
             incomplete += group.len() - u.len();
-            if u.len() >= 2 {
-                let (lo, hi) = u
-                    .iter()
-                    .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-                let spread = (hi - lo) / lo.abs();
+            if let Some(spread) = relative_spread(&u) {
                 worst = Some(worst.map_or(spread, |w: f64| w.max(spread)));
             }
         }
@@ -962,6 +954,17 @@ fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
         ));
     }
     out
+}
+
+/// (max − min)/|min| of at least two values, the spread of a sensitivity check.
+fn relative_spread(u: &[f64]) -> Option<f64> {
+    if u.len() < 2 {
+        return None;
+    }
+    let (lo, hi) = u
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+    Some((hi - lo) / lo.abs())
 }
 
 /// Solve every case of the tier.
