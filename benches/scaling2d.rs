@@ -4,7 +4,12 @@
 //! the peak memory belongs to that size alone:
 //!
 //! `cargo bench --bench scaling2d -- 1e4 1e5 1e6` (sizes are target point counts).
+//! `SCALING_GHOST=<gamma>[:all]` adds the ghost penalty (cut faces, or every face) to the
+//! residual, pattern and tangent, to measure its cost against the same run without it.
+//! `SCALING_SHIFT=<s>` translates every point by s·h in x and y first, so that the block's
+//! boundary cells are partially filled (the block starts cell-aligned: no cut faces).
 use igimp::assembly::{DofMap, LoadStepSystem};
+use igimp::ghost::{GhostFaces, GhostSettings};
 use igimp::linear::{LinearSolver, SparseSystem};
 use igimp::newton::NonlinearSystem;
 use igimp::problems::compaction::CompactionSpec;
@@ -18,6 +23,21 @@ fn peak_memory_mib() -> f64 {
         .map_or(f64::NAN, |kib| kib / 1024.0)
 }
 
+fn ghost_from_env() -> GhostSettings {
+    let mut g = GhostSettings::default();
+    if let Ok(v) = std::env::var("SCALING_GHOST") {
+        let mut parts = v.split(':');
+        g.gamma = parts
+            .next()
+            .and_then(|s| s.parse().ok())
+            .expect("SCALING_GHOST=<gamma>[:all]");
+        if parts.next() == Some("all") {
+            g.faces = GhostFaces::All;
+        }
+    }
+    g
+}
+
 fn run(target: f64, solver: LinearSolver) {
     // 2×2 points per cell in the 4 × 8 half block: 128 / h² points.
     let cells_per_unit = (target / 128.0).sqrt().round().max(1.0);
@@ -25,19 +45,36 @@ fn run(target: f64, solver: LinearSolver) {
     let spec = CompactionSpec {
         element_size: h,
         linear_solver: solver,
+        ghost: ghost_from_env(),
         ..CompactionSpec::default()
     };
     let t = Instant::now();
     let mut solver_mpm = spec.mpm_solver().expect("valid compaction");
     let setup = t.elapsed().as_secs_f64();
+    if let Some(shift) = std::env::var("SCALING_SHIFT")
+        .ok()
+        .and_then(|s| s.parse::<f64>().ok())
+    {
+        for x in solver_mpm.points.position.iter_mut() {
+            x.add_scalar_mut(shift * h);
+        }
+    }
     let t = Instant::now();
     solver_mpm.build_supports().unwrap();
     let weights = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    solver_mpm.build_ghost();
+    let ghost_build = t.elapsed().as_secs_f64();
+    let ghost = spec.ghost.is_on().then_some(solver_mpm.ghost());
     let table = solver_mpm.supports().clone();
     let t = Instant::now();
     let dofs = DofMap::build(solver_mpm.grid.num_nodes(), &table, &solver_mpm.fixed, &[]);
     let mut matrix = SparseSystem::default();
-    matrix.set_pattern(dofs.pattern(&table));
+    let mut columns = dofs.pattern(&table);
+    if let Some(g) = ghost {
+        g.add_pattern(&dofs, &mut columns);
+    }
+    matrix.set_pattern(columns);
     matrix.set_solver(solver);
     let pattern = t.elapsed().as_secs_f64();
     let f_ext = vec![1.0; dofs.len()];
@@ -51,7 +88,7 @@ fn run(target: f64, solver: LinearSolver) {
         matrix: &mut matrix,
         trials: &mut trials,
         du_nodal: &mut du,
-        ghost: None,
+        ghost,
         fixed_forces: &mut Vec::new(),
     };
     let u = vec![-1e-4; dofs.len()];
@@ -71,14 +108,15 @@ fn run(target: f64, solver: LinearSolver) {
     sys.matrix.solve_in_place(&mut r2).unwrap(); // numeric only (symbolic cached)
     let solve = t.elapsed().as_secs_f64();
     println!(
-        "{:>9} points, h = 1/{:<3} {:>8} dofs, nnz {:>9}, {:?}: setup {setup:.3} s | per iteration: weights {weights:.3} s, \
-         constitutive+residual {constitutive:.3} s, tangent assembly {tangent:.3} s, factorisation+solve {solve:.3} s \
+        "{:>9} points, h = 1/{:<3} {:>8} dofs, nnz {:>9}, {:?}, ghost {} faces: setup {setup:.3} s | per iteration: weights {weights:.3} s, \
+         ghost faces+fill {ghost_build:.3} s, constitutive+residual {constitutive:.3} s, tangent assembly {tangent:.3} s, factorisation+solve {solve:.3} s \
          (first, with symbolic: {first_solve:.3} s) | pattern {pattern:.3} s | peak memory {:.0} MiB",
         solver_mpm.points.len(),
         cells_per_unit,
         dofs.len(),
         sys.matrix.nnz(),
         solver,
+        ghost.map_or(0, |g| g.num_faces()),
         peak_memory_mib()
     );
 }

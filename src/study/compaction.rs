@@ -439,7 +439,7 @@ impl CompactionStudy {
             newton: self.newton.settings(),
             weak_node_tolerance: tolerance,
             weak_node_treatment: self.weak_nodes.treatment,
-            ghost: self.ghost.settings(ppc, gamma),
+            ghost: self.ghost.settings(ppc, s.yield_stress.is_some(), gamma),
             ..CompactionSpec::default()
         }
     }
@@ -455,7 +455,11 @@ impl CompactionStudy {
             if spec.weak_node_tolerance != self.weak_nodes.tolerance {
                 id.push_str(&format!("-wn{}", number(spec.weak_node_tolerance)));
             }
-            if spec.ghost != self.ghost.settings(spec.points_per_cell, None) {
+            if spec.ghost
+                != self
+                    .ghost
+                    .settings(spec.points_per_cell, spec.yield_stress.is_some(), None)
+            {
                 id.push_str(&format!("-g{}", number(spec.ghost.gamma)));
             }
         }
@@ -529,6 +533,8 @@ pub struct CompactionRecord {
     pub weak_node_tolerance: f64,
     /// Ghost penalty factor γ of the case (0: off; FEM: 0).
     pub ghost_gamma: f64,
+    /// Faces carrying the ghost penalty (`cut` or `all`).
+    pub ghost_faces: crate::ghost::GhostFaces,
     /// Load steps that needed cutbacks, and the failed attempts in all.
     pub steps_cut: usize,
     pub cutbacks: usize,
@@ -606,7 +612,7 @@ impl CompactionResults {
             None => true,
             Some(p) => {
                 c.weak_node_tolerance == self.study.weak_nodes.tolerance
-                    && c.ghost_gamma == self.study.ghost.settings(p, None).gamma
+                    && c.ghost_gamma == self.study.ghost.settings(p, c.yield_stress.is_some(), None).gamma
             }
         }
     }
@@ -638,14 +644,16 @@ struct CaseOutcome {
 /// Updated-Lagrangian Q4 FEM (2×2 Gauss points, LDLᵀ) of the modelled half block with the
 /// same supports, material and gravity ramp: the Figure 17 reference. The measure is the
 /// horizontal displacement of the bottom-right node.
-fn solve_fem_q4(spec: &CompactionSpec) -> Result<CaseOutcome, String> {
+/// Updated-Lagrangian FEM on the modelled half block: Q4 with 2×2 Gauss points (the paper's
+/// Figure 17 reference) or Q8 with 3×3 (a comparison for plastic flow, where Q4 locks).
+fn solve_fem(spec: &CompactionSpec, element: QuadElement) -> Result<CaseOutcome, String> {
     let h = spec.element_size;
     let cells = (
         (spec.half_width / h).round() as usize,
         (spec.height / h).round() as usize,
     );
     let size = V2::new(spec.half_width, spec.height);
-    let mesh = PlaneMesh::rectangle(V2::zeros(), size, cells, QuadElement::Q4).map_err(|e| e.to_string())?;
+    let mesh = PlaneMesh::rectangle(V2::zeros(), size, cells, element).map_err(|e| e.to_string())?;
     let tol = 1e-9 * h;
     let mut fixed: Vec<(usize, usize)> = mesh.nodes_at(0, 0.0, tol).into_iter().map(|n| (n, 0)).collect();
     fixed.extend(mesh.nodes_at(1, 0.0, tol).into_iter().map(|n| (n, 1)));
@@ -656,7 +664,7 @@ fn solve_fem_q4(spec: &CompactionSpec) -> Result<CaseOutcome, String> {
         nodal_forces: vec![],
     };
     let settings = PlaneFemSettings {
-        gauss_points: Some(2),
+        gauss_points: Some(if element == QuadElement::Q4 { 2 } else { 3 }),
         newton: spec.newton,
         load_steps: spec.load_steps,
         linear_solver: LinearSolver::Ldlt,
@@ -687,6 +695,7 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
         yield_stress: s.yield_stress,
         weak_node_tolerance: s.weak_node_tolerance,
         ghost_gamma: if case.method.is_fem() { 0.0 } else { s.ghost.gamma },
+        ghost_faces: s.ghost.faces,
         steps_cut: 0,
         cutbacks: 0,
         status: CaseStatus::Rejected,
@@ -707,8 +716,8 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
             weak_nodes_treated: o.weak_nodes_treated,
             domains: o.points,
         }),
-        PlaneMethod::FemQ4 => solve_fem_q4(s),
-        PlaneMethod::FemQ8 => Err("the compaction study uses Q4 elements (fem-q4)".to_string()),
+        PlaneMethod::FemQ4 => solve_fem(s, QuadElement::Q4),
+        PlaneMethod::FemQ8 => solve_fem(s, QuadElement::Q8),
     };
     match outcome {
         Err(reason) => {
@@ -1178,6 +1187,8 @@ fn cases_table(results: &CompactionResults) -> String {
             c.weak_node_tolerance,
             if c.method.is_fem() {
                 "—".into()
+            } else if c.ghost_gamma > 0.0 && c.ghost_faces == crate::ghost::GhostFaces::All {
+                format!("{} (all faces)", number(c.ghost_gamma))
             } else {
                 number(c.ghost_gamma)
             },

@@ -67,7 +67,8 @@ pub struct WeakNodeSection {
 }
 
 /// Ghost stabilisation as written in a study file ([`crate::ghost`]): γ and the faces for
-/// two or more points per cell, and the settings for one point per cell (every face).
+/// two or more points per cell, the settings for one point per cell (every face), and those
+/// of plastic cases.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GhostSection {
@@ -78,16 +79,21 @@ pub struct GhostSection {
     /// Settings for one point per cell; default: the ones above.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub one_point_per_cell: Option<crate::ghost::GhostSettings>,
+    /// Settings for plastic (von Mises) cases with two or more points per cell; default: the
+    /// ones above.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plastic: Option<crate::ghost::GhostSettings>,
     /// Where the defaults come from (the measurement that chose them).
     pub source: String,
 }
 
 impl GhostSection {
-    /// The settings of a case with `ppc` points per cell; `gamma` (a sweep's value) replaces
-    /// the default γ.
-    pub fn settings(&self, ppc: usize, gamma: Option<f64>) -> crate::ghost::GhostSettings {
-        let mut g = match (ppc, self.one_point_per_cell) {
-            (1, Some(one)) => one,
+    /// The settings of a case with `ppc` points per cell, plastic or not; `gamma` (a sweep's
+    /// value) replaces the default γ.
+    pub fn settings(&self, ppc: usize, plastic: bool, gamma: Option<f64>) -> crate::ghost::GhostSettings {
+        let mut g = match (ppc, self.one_point_per_cell, plastic, self.plastic) {
+            (1, Some(one), _, _) => one,
+            (_, _, true, Some(p)) => p,
             _ => crate::ghost::GhostSettings {
                 gamma: self.gamma,
                 faces: self.faces,
@@ -100,8 +106,9 @@ impl GhostSection {
     }
 
     pub fn validate(&self) -> Result<(), crate::error::InputError> {
-        self.settings(2, None).validate()?;
-        self.settings(1, None).validate()
+        self.settings(2, false, None).validate()?;
+        self.settings(2, true, None).validate()?;
+        self.settings(1, false, None).validate()
     }
 }
 
