@@ -90,6 +90,7 @@ fn run(target: f64, solver: LinearSolver) {
         du_nodal: &mut du,
         ghost,
         fixed_forces: &mut Vec::new(),
+        linearised: None,
     };
     let u = vec![-1e-4; dofs.len()];
     let mut r = vec![0.0; dofs.len()];

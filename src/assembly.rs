@@ -256,6 +256,37 @@ pub struct LoadStepSystem<'a, const D: usize> {
     /// Internal force at the dofs without an equation (fixed ones: the support reactions
     /// plus the external force there), indexed by nodal dof, at the last evaluation.
     pub fixed_forces: &'a mut Vec<f64>,
+    /// Linearised reaction update ([`ResidualNorm::Linearised`]); `None`: not tracked.
+    pub linearised: Option<&'a mut LinearisedReactions>,
+}
+
+/// The fixed rows of the tangent at the last assembly and the state they were formed at, for
+/// the reactions as the paper's group updates them (AMPLE: f_rct += K_f δu − f^ob_f). After
+/// an update to u the out-of-balance left at the fixed dofs telescopes to
+/// f^ob_f(u) = −[f_int,f(u) − f_int,f(u_t) − K_f(u_t)(u − u_t)], u_t the tangent's state,
+/// and f_ext,f + f_rct = f_int,f(u) + f^ob_f(u) (reference/README.md, item 18).
+#[derive(Debug, Default)]
+pub struct LinearisedReactions {
+    /// (nodal dof, equation, value) entries of K_f (material part; the ghost part is added
+    /// from the operator, it is linear).
+    rows: Vec<(usize, usize, f64)>,
+    /// u and f_int at the fixed dofs when the tangent was formed; empty before the first.
+    u_t: Vec<f64>,
+    fixed_t: Vec<f64>,
+    /// The last evaluation's u and out-of-balance at the fixed dofs (nodal dof order).
+    u_last: Vec<f64>,
+    oob: Vec<f64>,
+    scratch_nodal: Vec<f64>,
+    scratch_eq: Vec<f64>,
+}
+
+impl LinearisedReactions {
+    fn clear(&mut self) {
+        self.rows.clear();
+        self.u_t.clear();
+        self.fixed_t.clear();
+        self.oob.clear();
+    }
 }
 
 impl<const D: usize> LoadStepSystem<'_, D> {
@@ -341,6 +372,40 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         nodes.len()
     }
 
+    /// The out-of-balance left at the fixed dofs by the linearised reaction update, at `u`
+    /// (see [`LinearisedReactions`]); zero before the first tangent (exact reactions).
+    fn update_fixed_out_of_balance(&mut self, u: &[f64]) {
+        let Some(lin) = self.linearised.as_deref_mut() else {
+            return;
+        };
+        lin.u_last.clear();
+        lin.u_last.extend_from_slice(u);
+        lin.oob.clear();
+        if lin.u_t.len() != u.len() {
+            return;
+        }
+        // −[f_int,f(u) − f_int,f(u_t) − K_f (u − u_t)]
+        lin.oob
+            .extend(self.fixed_forces.iter().zip(&lin.fixed_t).map(|(f, t)| t - f));
+        for &(dof, col, k) in &lin.rows {
+            lin.oob[dof] += k * (u[col] - lin.u_t[col]);
+        }
+        if let Some(g) = self.ghost {
+            let diff: Vec<f64> = u.iter().zip(&lin.u_t).map(|(a, b)| a - b).collect();
+            lin.scratch_nodal.clear();
+            lin.scratch_nodal.resize(self.dofs.num_dofs(), 0.0);
+            self.dofs.expand(&diff, &mut lin.scratch_nodal);
+            lin.scratch_eq.clear();
+            lin.scratch_eq.resize(u.len(), 0.0);
+            g.add_residual(
+                self.dofs,
+                &lin.scratch_nodal,
+                &mut lin.scratch_eq,
+                Some(&mut lin.oob),
+            );
+        }
+    }
+
     /// Assemble the tangent `K = Σ_p [G]ᵀ[a][G] V_p` (eq 27) at the trial states of the last
     /// [`Self::assemble_residual`].
     ///
@@ -352,6 +417,11 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         const CHUNK: usize = 4096;
         let stride_eq = MAX_POINT_NODES * D;
         self.matrix.clear_values();
+        if let Some(lin) = self.linearised.as_deref_mut() {
+            lin.rows.clear();
+            lin.u_t.clone_from(&lin.u_last);
+            lin.fixed_t.clone_from(self.fixed_forces);
+        }
         let n = self.states.len();
         let (table, dofs, model, states, trials) =
             (self.table, self.dofs, self.model, self.states, &*self.trials);
@@ -416,6 +486,28 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                         }
                     }
                 });
+            if let Some(lin) = self.linearised.as_deref_mut() {
+                for i in 0..len {
+                    let md = sizes[i];
+                    let eqs = &eq_buf[i * stride_eq..i * stride_eq + md];
+                    if eqs.iter().all(Option::is_some) {
+                        continue;
+                    }
+                    let nodes = table.point(start + i).0;
+                    let kl = &local[i * stride_k..];
+                    for (ri, row) in eqs.iter().enumerate() {
+                        if row.is_some() {
+                            continue;
+                        }
+                        let dof = nodes[ri / D] * D + ri % D;
+                        for (ci, col) in eqs.iter().enumerate() {
+                            if let Some(col) = *col {
+                                lin.rows.push((dof, col, kl[ri * md + ci]));
+                            }
+                        }
+                    }
+                }
+            }
             let (local, eq_buf, sizes) = (&local, &eq_buf, &sizes);
             self.matrix
                 .column_blocks(threads)
@@ -457,7 +549,13 @@ impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
         for (r, f) in residual.iter_mut().zip(self.f_ext) {
             *r -= f;
         }
+        self.update_fixed_out_of_balance(u);
         Ok(())
+    }
+    fn fixed_out_of_balance_sq(&self) -> f64 {
+        self.linearised
+            .as_deref()
+            .map_or(0.0, |l| l.oob.iter().map(|x| x * x).sum())
     }
     fn solve_tangent(&mut self, rhs: &mut [f64]) -> Result<(), StepFailure> {
         self.assemble_tangent();
@@ -470,6 +568,19 @@ impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
             // ‖f_ext + f_reaction‖ over all dofs: f_ext at the free dofs and, at the fixed
             // ones, f_ext + reaction = f_int of the last evaluation.
             ResidualNorm::Total => (ext + self.fixed_forces.iter().map(|x| x * x).sum::<f64>()).sqrt(),
+            // f_ext + f_rct at the fixed dofs = f_int + f^ob there.
+            ResidualNorm::Linearised => {
+                let fixed: f64 = match self.linearised.as_deref() {
+                    Some(l) if !l.oob.is_empty() => self
+                        .fixed_forces
+                        .iter()
+                        .zip(&l.oob)
+                        .map(|(f, o)| (f + o).powi(2))
+                        .sum(),
+                    _ => self.fixed_forces.iter().map(|x| x * x).sum(),
+                };
+                (ext + fixed).sqrt()
+            }
         }
     }
 }
@@ -486,6 +597,8 @@ pub struct StepWorkspace<const D: usize> {
     pub du_nodal: Vec<f64>,
     /// Internal force at the fixed dofs at the last evaluation (see [`LoadStepSystem`]).
     pub fixed_forces: Vec<f64>,
+    /// Linearised reactions ([`ResidualNorm::Linearised`]).
+    pub linearised: LinearisedReactions,
 }
 
 /// What a load step applies, besides the material model and the committed states.
@@ -513,6 +626,16 @@ impl<const D: usize> StepWorkspace<D> {
         input: &StepInput<'_, D>,
         f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
     ) -> R {
+        self.with_system_tracking(input, false, f)
+    }
+
+    /// [`Self::with_system`], tracking the linearised reactions if `track`.
+    fn with_system_tracking<R>(
+        &mut self,
+        input: &StepInput<'_, D>,
+        track: bool,
+        f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
+    ) -> R {
         let dofs = DofMap::build(input.num_nodes, &self.table, input.fixed, input.ties);
         let mut columns = dofs.pattern(&self.table);
         if let Some(g) = input.ghost {
@@ -537,6 +660,7 @@ impl<const D: usize> StepWorkspace<D> {
             du_nodal: &mut self.du_nodal,
             ghost: input.ghost,
             fixed_forces: &mut self.fixed_forces,
+            linearised: track.then_some(&mut self.linearised),
         };
         f(&mut system)
     }
@@ -548,7 +672,9 @@ impl<const D: usize> StepWorkspace<D> {
         input: &StepInput<'_, D>,
         settings: &NewtonSettings,
     ) -> Result<NewtonReport, (StepFailure, Vec<f64>)> {
-        self.with_system(input, |system| {
+        self.linearised.clear();
+        let track = settings.residual_norm == ResidualNorm::Linearised;
+        self.with_system_tracking(input, track, |system| {
             let mut u = vec![0.0; system.num_unknowns()];
             newton::solve(system, &mut u, settings)
         })

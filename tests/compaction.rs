@@ -3,15 +3,18 @@
 //! recorded rather than panicking.
 
 use igimp::ghost::GhostSettings;
-use igimp::newton::check_quadratic;
+use igimp::newton::{check_quadratic, ResidualNorm};
 use igimp::problems::compaction::{solve_mpm, CompactionSpec};
 
 /// Paper Table 2 (elastic, h = 1, 2×2 points, steps 16–20): the normalised out-of-balance
-/// force after Newton iterations 1, 2, 3. Reference: the paper's printed values; tolerance: a
-/// factor of 2 on iterations 1 and 2 (geometry and normalisation details are not fully
-/// specified), iteration 3 at round-off (< 1e-12), and the quadratic criterion of the column
-/// tests. Measured at step 16: 1.590e-3, 6.171e-7, 1.027e-13 (paper 1.357e-3, 4.805e-7,
-/// 6.903e-14).
+/// force after Newton iterations 1, 2, 3, with the paper's normalisation (`linearised`:
+/// reactions updated by their linearised increment, AMPLE's scheme; reference/README.md item
+/// 18). Reference: the paper's printed values. Tolerances: iteration 1 within 5 % (the issue's
+/// band; measured 2026-12-01: at most 1.9 %); iteration 2 within 7 % at steps 16, 17, 18, 20
+/// (measured at most 6.6 %, step 20) and 15 % at step 19 (measured 12.9 %: the paper's step 19
+/// is off its own trend, its iteration 3 printed as 1.839e-12 against 3–7e-14 at the
+/// neighbouring steps); iteration 3 at round-off (< 1e-12); the quadratic criterion of the
+/// column tests. With `external` iteration 1 is 17 % above the paper's (1.590e-3 at step 16).
 #[test]
 fn paper_table2_elastic_newton_pattern() {
     let paper = [
@@ -21,7 +24,9 @@ fn paper_table2_elastic_newton_pattern() {
         [1.094e-3, 3.478e-7],
         [9.897e-4, 2.872e-7],
     ];
-    let o = solve_mpm(&CompactionSpec::default()).unwrap();
+    let mut spec = CompactionSpec::default();
+    spec.newton.residual_norm = ResidualNorm::Linearised;
+    let o = solve_mpm(&spec).unwrap();
     assert!(o.failure.is_none(), "{:?}", o.failure);
     for s in &o.steps {
         check_quadratic(&s.newton.residuals, 1e-3, 1e-11, 1.0, 1.8)
@@ -34,21 +39,33 @@ fn paper_table2_elastic_newton_pattern() {
         );
     }
     for (k, row) in paper.iter().enumerate() {
-        let r = &o.steps[15 + k].newton.residuals;
-        assert_eq!(r.len(), 4, "step {}: {r:?}", 16 + k);
+        let step = 16 + k;
+        let r = &o.steps[step - 1].newton.residuals;
+        assert_eq!(r.len(), 4, "step {step}: {r:?}");
+        let bands = [0.05, if step == 19 { 0.15 } else { 0.07 }];
         for it in 0..2 {
-            let ratio = r[it + 1] / row[it];
+            let dev = (r[it + 1] / row[it] - 1.0).abs();
             assert!(
-                (0.5..=2.0).contains(&ratio),
-                "step {} iteration {}: {:.3e} vs paper {:.3e}",
-                16 + k,
+                dev <= bands[it],
+                "step {step} iteration {}: {:.3e} vs paper {:.3e} ({:.1} %)",
                 it + 1,
                 r[it + 1],
-                row[it]
+                row[it],
+                100.0 * dev
             );
         }
         assert!(r[3] < 1e-12);
     }
+}
+
+/// The `external` normalisation (‖f_ext‖ over the free dofs) does not reproduce Table 2: the
+/// same run is 17 % above the paper at iteration 1 of step 16 (a check that the agreement
+/// above comes from the normalisation, not from the run).
+#[test]
+fn table2_with_external_norm_is_off_the_paper() {
+    let o = solve_mpm(&CompactionSpec::default()).unwrap();
+    let r1 = o.steps[15].newton.residuals[1];
+    assert!(r1 / 1.357e-3 - 1.0 > 0.1, "{r1:e}");
 }
 
 /// Paper Table 3 (von Mises, ρ_y = 1.2×10⁴, h = 1): more iterations while the plastic zone

@@ -65,6 +65,7 @@ fn patch<const D: usize>(
         du_nodal: &mut du,
         ghost: None,
         fixed_forces: &mut Vec::new(),
+        linearised: None,
     };
     let mut r = vec![0.0; dofs.len()];
     sys.evaluate(&u, &mut r).unwrap();

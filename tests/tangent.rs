@@ -128,6 +128,7 @@ fn tangent_error_with<const D: usize>(
         du_nodal: &mut du,
         ghost: ghost.as_ref(),
         fixed_forces: &mut Vec::new(),
+        linearised: None,
     };
     let mut r0 = vec![0.0; n];
     sys.evaluate(&u0, &mut r0).unwrap();

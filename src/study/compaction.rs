@@ -20,6 +20,7 @@ use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads};
 use crate::fem::{PlaneMesh, QuadElement};
 use crate::linear::LinearSolver;
 use crate::newton::LoadStepping;
+use crate::newton::ResidualNorm;
 use crate::newton::StepReport;
 use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, XyAxes, XySeries};
 use crate::problems::compaction::{solve_mpm, CompactionSpec, DomainRecord};
@@ -1051,9 +1052,18 @@ fn ppc_label(p: usize) -> String {
 pub fn residual_table(results: &CompactionResults, p: &PaperResiduals) -> String {
     let mut s = format!("# {}: {}\n\n{}\n\n", p.table, p.title, results.provenance.line());
     let case = results.igimp_case(&p.sweep, p.element_size, p.points_per_cell as usize);
+    let measure = match results.study.newton.residual_norm {
+        ResidualNorm::External => "‖f_int − f_ext‖ / ‖f_ext‖ over the free dofs (`external`)",
+        ResidualNorm::Total => {
+            "‖f_int − f_ext‖ over the free dofs / ‖f_ext + f_reaction‖ over all dofs, exact reactions (`total`)"
+        }
+        ResidualNorm::Linearised => {
+            "‖f^ob‖ / ‖f_ext + f_rct‖ over all dofs, the reactions updated by their linearised increment as the paper's group computes them (`linearised`, reference/README.md item 18)"
+        }
+    };
     let _ = writeln!(
         s,
-        "Normalised out-of-balance force ‖f_int − f_ext‖ / ‖f_ext‖ after each Newton iteration \
+        "Normalised out-of-balance force {measure} after each Newton iteration \
          (iteration k is the residual after the k-th solve), case `{}`. \"code\" is this code, \
          \"paper\" the printed value.\n",
         case.map_or("(not run in this tier)", |c| c.id.as_str())

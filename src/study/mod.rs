@@ -148,8 +148,9 @@ pub struct NewtonSection {
     /// Backtracking line search (default off: plain Newton as in the paper).
     #[serde(default)]
     pub line_search: bool,
-    /// `external` (‖f_ext‖ over the free dofs, the default) or `total` (‖f_ext + f_reaction‖
-    /// over all dofs, the paper's Tables 2–3).
+    /// `external` (‖f_ext‖ over the free dofs, the default), `total` (‖f_ext + f_reaction‖
+    /// over all dofs, exact reactions) or `linearised` (the paper's Tables 2–3: reactions
+    /// updated by their linearised increment, their out-of-balance in the numerator).
     #[serde(default)]
     pub residual_norm: crate::newton::ResidualNorm,
     /// Adaptive load stepping: most halvings of a failing increment (0..=20, default 6:
