@@ -99,6 +99,38 @@ fn main() {
                 "  section at L - h: u/L {bu:.5} v/L {bv:.5} ({} points)",
                 back.len()
             );
+            // Length of the beam axis: the polyline through the mean final position of each
+            // column of points (same x0), against its initial length.
+            let mut cols: std::collections::BTreeMap<i64, (f64, f64, f64, usize)> = Default::default();
+            for p in 0..s0.len() {
+                let key = (s0[p][0] * 1e6).round() as i64;
+                let e = cols.entry(key).or_insert((s0[p][0], 0.0, 0.0, 0));
+                e.1 += s1[p][0];
+                e.2 += s1[p][1];
+                e.3 += 1;
+            }
+            let pts: Vec<(f64, f64, f64)> = cols
+                .values()
+                .map(|&(x0, sx, sy, n)| (x0, sx / n as f64, sy / n as f64))
+                .collect();
+            let len: f64 = pts
+                .windows(2)
+                .map(|w| ((w[1].1 - w[0].1).powi(2) + (w[1].2 - w[0].2).powi(2)).sqrt())
+                .sum();
+            let len0 = pts.last().unwrap().0 - pts[0].0;
+            println!(
+                "  axis length {len:.5} of {len0:.5} (strain {:.4} %)",
+                100.0 * (len / len0 - 1.0)
+            );
+            if std::env::var("AXIS").is_ok() {
+                for w in pts.windows(2).step_by(3) {
+                    let ang = (w[1].2 - w[0].2).atan2(w[1].1 - w[0].1);
+                    println!(
+                        "    x0 {:.3}: x {:.4} y {:.4} angle {:.4}",
+                        w[0].0, w[0].1, w[0].2, ang
+                    );
+                }
+            }
             let cuts: usize = o.steps.iter().map(|s| s.cutbacks()).sum();
             println!(
                 "cantilever h={} {} {:?}: u/L {:.5} v/L {:.5} steps {} cutbacks {cuts} fail {:?} {:.1}s",

@@ -2,7 +2,7 @@
 //! Tables 2 and 3, the weak-node treatment's insensitivity to its tolerance, and failures
 //! recorded rather than panicking.
 
-use igimp::ghost::GhostSettings;
+use igimp::ghost::{GhostFaces, GhostSettings};
 use igimp::newton::{check_quadratic, ResidualNorm};
 use igimp::problems::compaction::{solve_mpm, CompactionSpec};
 
@@ -68,30 +68,36 @@ fn table2_with_external_norm_is_off_the_paper() {
     assert!(r1 / 1.357e-3 - 1.0 > 0.1, "{r1:e}");
 }
 
-/// Paper Table 3 (von Mises, ρ_y = 1.2×10⁴, h = 1): more iterations while the plastic zone
-/// settles, then asymptotic quadratic convergence: r_{k+1} ≤ C r_k² once r_k ≤ 1e-4, round-off
-/// floor 1e-10, observed order ≥ 1.8 where three residuals qualify. C = 200 admits the paper's
-/// own Table 3, whose largest such ratio is 156 (step 16: 8.852e-6 / (2.379e-4)²; 2.6 below
-/// 1e-4). Measured with the ghost default (2026-12-01): 99.7 at step 16 (3.195e-6 → 1.018e-9,
-/// order 1.85 from 2.544e-4), at most 9.3 in every other step. Above 1e-4 the active plastic
-/// set may still change, as in the paper's iterations 1-4.
+/// Paper Table 3 (von Mises, ρ_y = 1.2×10⁴, h = 1, the study's plastic treatment): more
+/// iterations while the plastic zone settles, then asymptotic quadratic convergence:
+/// r_{k+1} ≤ C r_k² once r_k ≤ 1e-4, with C = 20, round-off floor 1e-10, observed order ≥ 1.8
+/// where three residuals qualify. Above 1e-4 the active plastic set may still change, as in
+/// the paper's iterations 1-4 (its step 16 has 8.852e-6 / (2.379e-4)² = 156); below 1e-4 every
+/// pair of the paper's Table 3 satisfies C = 20 (largest 2.6). Measured 2026-12-01: largest
+/// ratio 2.7 (step 16), 5 qualifying pairs (most steps jump from above 1e-4 to the floor).
 #[test]
 fn paper_table3_plastic_newton_reaches_quadratic_convergence() {
+    // The compaction study's plastic treatment: the ghost penalty on every face, γ = 0.1
+    // (studies/compaction.toml, [ghost] plastic).
     let spec = CompactionSpec {
         yield_stress: Some(1.2e4),
+        ghost: GhostSettings {
+            gamma: 0.1,
+            faces: GhostFaces::All,
+            ..Default::default()
+        },
         ..CompactionSpec::default()
     };
     let o = solve_mpm(&spec).unwrap();
     assert!(o.failure.is_none(), "{:?}", o.failure);
     let mut checks = 0;
     for s in &o.steps {
-        let c = check_quadratic(&s.newton.residuals, 1e-4, 1e-10, 200.0, 1.8)
+        let c = check_quadratic(&s.newton.residuals, 1e-4, 1e-10, 20.0, 1.8)
             .unwrap_or_else(|e| panic!("step {}: {e}", s.step));
         checks += c.ratio_checks;
         assert!(s.newton.iterations() <= 10);
     }
-    // Measured: 7 pairs qualify (most steps jump from above 1e-4 to below the floor).
-    assert!(checks >= 5, "{checks} ratio checks");
+    assert!(checks >= 3, "{checks} ratio checks");
     // Plastic flow spreads the block far more than the elastic case (Figure 18).
     let elastic = solve_mpm(&CompactionSpec::default()).unwrap();
     assert!(o.max_horizontal_displacement > 5.0 * elastic.max_horizontal_displacement);

@@ -36,6 +36,7 @@ fn one_point_per_cell_column_converges_with_ghost_on_every_face() {
     let ghost = GhostSettings {
         gamma: 0.1,
         faces: GhostFaces::All,
+        ..Default::default()
     };
     let elements = [64, 128, 256, 512, 1024, 2048];
     let mut stress = vec![];
@@ -71,6 +72,7 @@ fn one_point_column_gamma_sensitivity_is_small() {
             let g = GhostSettings {
                 gamma,
                 faces: GhostFaces::All,
+                ..Default::default()
             };
             solve_column(&one_point_column(256, g), Method::Igimp)
                 .unwrap()
@@ -83,9 +85,10 @@ fn one_point_column_gamma_sensitivity_is_small() {
     assert!((hi - lo) / lo.abs() < 2e-4, "{top:?}");
 }
 
-/// Adaptive load stepping: the von Mises block in 3 load steps needs a cutback in its last
-/// step (measured 2026-12-01: one, the full increment inverts point 72); the nominal levels are hit exactly, every attempt is recorded, and with cutbacks off
-/// the same run fails at that step.
+/// Adaptive load stepping: the von Mises block in 3 load steps needs cutbacks (measured
+/// 2026-12-01, cut faces below a fill of 0.1: in step 2); the nominal levels are hit exactly,
+/// every attempt is recorded, and with cutbacks off the same run fails at the first step that
+/// needed them.
 #[test]
 fn cutbacks_hit_the_nominal_levels_and_are_recorded() {
     let spec = CompactionSpec {
@@ -94,6 +97,7 @@ fn cutbacks_hit_the_nominal_levels_and_are_recorded() {
         ghost: GhostSettings {
             gamma: 1.0,
             faces: GhostFaces::Cut,
+            ..Default::default()
         },
         ..CompactionSpec::default()
     };
@@ -102,12 +106,15 @@ fn cutbacks_hit_the_nominal_levels_and_are_recorded() {
     for (k, s) in o.steps.iter().enumerate() {
         assert_eq!(s.load_factor, (k + 1) as f64 / 3.0);
     }
-    let cut = &o.steps[2];
-    assert!(cut.cutbacks() >= 1, "{:?}", cut.substeps);
+    let cut = o
+        .steps
+        .iter()
+        .find(|s| s.cutbacks() >= 1)
+        .expect("a step needs cutbacks");
     let failed: Vec<_> = cut.substeps.iter().filter(|s| !s.converged).collect();
     assert!(failed.iter().all(|s| s.failure.is_some()));
     assert!(cut.substeps.last().unwrap().converged);
-    assert_eq!(cut.substeps.last().unwrap().load_factor, 1.0);
+    assert_eq!(cut.substeps.last().unwrap().load_factor, cut.load_factor);
     let mut lf: Vec<f64> = cut
         .substeps
         .iter()
@@ -116,11 +123,12 @@ fn cutbacks_hit_the_nominal_levels_and_are_recorded() {
         .collect();
     lf.dedup();
     assert!(lf.windows(2).all(|w| w[1] > w[0]), "{lf:?}");
+    let first_cut = cut.step;
     let mut fixed = spec;
     fixed.newton.max_cutbacks = 0;
     let o = solve_mpm(&fixed).unwrap();
     let f = o.failure.expect("fixed steps fail");
-    assert_eq!((f.step, f.attempts), (3, 1));
+    assert_eq!((f.step, f.attempts), (first_cut, 1));
 }
 
 /// Near-incompressible input (ν = 0.49999999): the failure names the round-off stall and the
@@ -132,6 +140,7 @@ fn near_incompressible_compaction_reports_the_stall() {
         ghost: GhostSettings {
             gamma: 1.0,
             faces: GhostFaces::Cut,
+            ..Default::default()
         },
         ..CompactionSpec::default()
     };
@@ -154,6 +163,7 @@ fn slow_divergence_is_not_called_a_stall() {
         ghost: GhostSettings {
             gamma: 1.0,
             faces: GhostFaces::Cut,
+            ..Default::default()
         },
         ..CompactionSpec::default()
     };

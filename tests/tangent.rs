@@ -190,10 +190,13 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
     let all = GhostSettings {
         gamma: 0.5,
         faces: GhostFaces::All,
+        ..Default::default()
     };
+    // Cells half filled count as cut below a fill of 0.6.
     let cut = GhostSettings {
         gamma: 0.5,
         faces: GhostFaces::Cut,
+        cut_fill: 0.6,
     };
     // (basis, ghost, upper corner of the material): [3.5, 2.5] leaves half-filled cells.
     let variants = [

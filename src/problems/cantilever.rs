@@ -79,6 +79,7 @@ impl Default for CantileverSpec {
             ghost: GhostSettings {
                 gamma: 1e-2,
                 faces: GhostFaces::Cut,
+                ..Default::default()
             },
         }
     }

@@ -80,6 +80,7 @@ impl Default for CompactionSpec {
             ghost: GhostSettings {
                 gamma: 1.0,
                 faces: GhostFaces::Cut,
+                ..Default::default()
             },
         }
     }

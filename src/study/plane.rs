@@ -76,6 +76,10 @@ pub struct GhostSection {
     pub gamma: f64,
     #[serde(default)]
     pub faces: crate::ghost::GhostFaces,
+    /// Fill fraction below which a cell is cut, in (0, 1]; default
+    /// [`crate::ghost::DEFAULT_CUT_FILL`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cut_fill: Option<f64>,
     /// Settings for one point per cell; default: the ones above.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub one_point_per_cell: Option<crate::ghost::GhostSettings>,
@@ -97,6 +101,7 @@ impl GhostSection {
             _ => crate::ghost::GhostSettings {
                 gamma: self.gamma,
                 faces: self.faces,
+                cut_fill: self.cut_fill.unwrap_or(crate::ghost::DEFAULT_CUT_FILL),
             },
         };
         if let Some(gamma) = gamma {
