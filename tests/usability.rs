@@ -71,12 +71,17 @@ fn write_study(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 fn run(dir: &Path, name: &str, out: &str, threads: usize, extra: &[&str]) -> String {
+    run_with(&dir.join("studies"), name, &dir.join(out), threads, extra)
+}
+
+/// Run study `name` of the folder `studies` into `out`; its stderr.
+fn run_with(studies: &Path, name: &str, out: &Path, threads: usize, extra: &[&str]) -> String {
     let output = study_bin()
         .arg(name)
         .arg("--studies-dir")
-        .arg(dir.join("studies"))
+        .arg(studies)
         .arg("--out")
-        .arg(dir.join(out))
+        .arg(out)
         .args(extra)
         .env("RAYON_NUM_THREADS", threads.to_string())
         .output()
@@ -239,23 +244,9 @@ fn resumed_count(stderr: &str) -> (usize, usize) {
     (words[at + 1].parse().unwrap(), words[at + 3].parse().unwrap())
 }
 
-/// A run killed after its first finished case, rerun with `--resume`, reuses the finished
-/// cases, solves the rest and ends with the results.json of an uninterrupted run (wall times
-/// aside). Killed on one thread, uninterrupted on two: also a thread-count check.
-#[test]
-fn killed_sweep_resumes_to_the_uninterrupted_results() {
-    let tmp = tempfile::tempdir().unwrap();
-    write_study(tmp.path(), "slow", SLOW);
-    let cases = tmp.path().join("killed/slow/cases");
-    let mut child = study_bin()
-        .args(["slow", "--studies-dir"])
-        .arg(tmp.path().join("studies"))
-        .arg("--out")
-        .arg(tmp.path().join("killed"))
-        .env("RAYON_NUM_THREADS", "1")
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+/// Spawn `cmd`, wait until a first case file appears in `cases`, and kill it.
+fn kill_after_first_case(mut cmd: Command, cases: &Path) {
+    let mut child = cmd.stderr(Stdio::null()).spawn().unwrap();
     let start = Instant::now();
     let finished = |d: &Path| {
         std::fs::read_dir(d).map_or(0, |r| {
@@ -264,7 +255,7 @@ fn killed_sweep_resumes_to_the_uninterrupted_results() {
                 .count()
         })
     };
-    while finished(&cases) == 0 {
+    while finished(cases) == 0 {
         assert!(start.elapsed() < Duration::from_secs(120), "no case finished");
         assert!(
             child.try_wait().unwrap().is_none(),
@@ -274,6 +265,23 @@ fn killed_sweep_resumes_to_the_uninterrupted_results() {
     }
     child.kill().unwrap();
     child.wait().unwrap();
+}
+
+/// A run killed after its first finished case, rerun with `--resume`, reuses the finished
+/// cases, solves the rest and ends with the results.json of an uninterrupted run (wall times
+/// aside). Killed on one thread, uninterrupted on two: also a thread-count check.
+#[test]
+fn killed_sweep_resumes_to_the_uninterrupted_results() {
+    let tmp = tempfile::tempdir().unwrap();
+    write_study(tmp.path(), "slow", SLOW);
+    let cases = tmp.path().join("killed/slow/cases");
+    let mut cmd = study_bin();
+    cmd.args(["slow", "--studies-dir"])
+        .arg(tmp.path().join("studies"))
+        .arg("--out")
+        .arg(tmp.path().join("killed"))
+        .env("RAYON_NUM_THREADS", "1");
+    kill_after_first_case(cmd, &cases);
     assert!(
         !tmp.path().join("killed/slow/results.json").exists(),
         "the run finished before it was killed; the cases are too small for this machine"
@@ -348,5 +356,112 @@ fn results_identical_on_one_and_two_threads() {
                 "{p}"
             );
         }
+    }
+}
+
+/// Run a study of the repository's `studies/` (quick tier) into `<dir>/<out>`.
+fn run_repo_quick(dir: &Path, name: &str, out: &str, threads: usize, extra: &[&str]) -> String {
+    let studies = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies");
+    let mut args = vec!["--quick"];
+    args.extend_from_slice(extra);
+    run_with(&studies, name, &dir.join(out), threads, &args)
+}
+
+/// The 2D studies honour `--resume` and `--vtk` as the column does: the compaction run is
+/// killed after its first finished case and resumed, the cantilever loses half its stored
+/// cases and is resumed; both end with the results.json of an uninterrupted run (timing
+/// aside), and meshio reads the domains of the final frame back equal to domains.json.
+#[test]
+fn plane_studies_resume_and_write_vtk() {
+    use igimp::study::{cantilever, compaction};
+    let tmp = tempfile::tempdir().unwrap();
+    let cases = tmp.path().join("killed/compaction/cases");
+    let mut cmd = study_bin();
+    cmd.args(["compaction", "--quick", "--vtk", "--studies-dir"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("studies"))
+        .arg("--out")
+        .arg(tmp.path().join("killed"))
+        .env("RAYON_NUM_THREADS", "1");
+    kill_after_first_case(cmd, &cases);
+    assert!(!tmp.path().join("killed/compaction/results.json").exists());
+    let stderr = run_repo_quick(tmp.path(), "compaction", "killed", 2, &["--resume", "--vtk"]);
+    let (resumed, total) = resumed_count(&stderr);
+    assert!((1..total).contains(&resumed), "resumed {resumed} of {total}");
+    run_repo_quick(tmp.path(), "compaction", "clean", 2, &[]);
+    let a = compaction::read_results(&tmp.path().join("killed/compaction")).unwrap();
+    let b = compaction::read_results(&tmp.path().join("clean/compaction")).unwrap();
+    assert_eq!(a.without_timing(), b.without_timing());
+
+    run_repo_quick(tmp.path(), "cantilever", "killed", 2, &["--vtk"]);
+    let stored = tmp.path().join("killed/cantilever/cases");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&stored)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    for f in files.iter().step_by(2) {
+        std::fs::remove_file(f).unwrap();
+    }
+    std::fs::remove_file(tmp.path().join("killed/cantilever/results.json")).unwrap();
+    let stderr = run_repo_quick(tmp.path(), "cantilever", "killed", 2, &["--resume", "--vtk"]);
+    let (resumed, total) = resumed_count(&stderr);
+    assert_eq!(resumed, total - files.len().div_ceil(2), "{stderr}");
+    run_repo_quick(tmp.path(), "cantilever", "clean", 2, &[]);
+    let a = cantilever::read_results(&tmp.path().join("killed/cantilever")).unwrap();
+    let b = cantilever::read_results(&tmp.path().join("clean/cantilever")).unwrap();
+    assert_eq!(a.without_timing(), b.without_timing());
+
+    // ParaView files: one .pvd per iGIMP case; the final frame of Figure 15's case holds the
+    // domains of domains.json.
+    let vtk = tmp.path().join("killed/compaction/vtk");
+    for c in a
+        .cases
+        .iter()
+        .filter(|c| c.method == igimp::study::plane::PlaneMethod::Igimp)
+    {
+        assert!(
+            tmp.path()
+                .join(format!("killed/cantilever/vtk/{}.pvd", c.id))
+                .is_file(),
+            "{}",
+            c.id
+        );
+    }
+    if !meshio_available() {
+        return;
+    }
+    let id = "igimp-elastic-h1-p2";
+    let last = vtk.join(id).join("domains_00020.vtu");
+    let domains: Value =
+        serde_json::from_slice(&std::fs::read(tmp.path().join("killed/compaction/domains.json")).unwrap())
+            .unwrap();
+    let doms = domains[id].as_array().unwrap();
+    const SCRIPT: &str = r#"
+import json, sys, meshio
+m = meshio.read(sys.argv[1])
+print(json.dumps({"type": m.cells[0].type, "n": len(m.cells[0].data),
+                  "centre": m.cell_data["centre"][0].tolist(),
+                  "sigma_yy": m.cell_data["sigma_yy"][0].reshape(-1).tolist()}))
+"#;
+    let out = Command::new("python3")
+        .arg("-c")
+        .arg(SCRIPT)
+        .arg(&last)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let m: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(m["type"], "quad");
+    assert_eq!(m["n"].as_u64().unwrap() as usize, doms.len());
+    for (p, d) in doms.iter().enumerate() {
+        for a in 0..2 {
+            let (v, r) = (m["centre"][p][a].as_f64().unwrap(), d["x"][a].as_f64().unwrap());
+            assert!((v - r).abs() <= 1e-12 * r.abs().max(1.0), "point {p}: {v} vs {r}");
+        }
+        let (v, r) = (
+            m["sigma_yy"][p].as_f64().unwrap(),
+            d["sigma_yy"].as_f64().unwrap(),
+        );
+        assert!((v - r).abs() <= 1e-12 * r.abs().max(1.0), "point {p}: {v} vs {r}");
     }
 }

@@ -48,11 +48,13 @@ struct Cli {
     /// (`<out>/<name>/cases/`, keyed by a hash of each case's definition); solve the rest.
     #[arg(long)]
     resume: bool,
-    /// Write ParaView files: `<out>/<name>/vtk/<case>.pvd` with the material/Gauss points and
-    /// the grid/mesh of the initial and the final state.
+    /// Write ParaView files `<out>/<name>/vtk/<case>.pvd` of the initial and the final state:
+    /// column, the material/Gauss points and the grid/mesh; compaction and cantilever, the
+    /// material point domains (quadrilaterals) of the iGIMP cases (FEM cases write none).
     #[arg(long)]
     vtk: bool,
-    /// With --vtk, also write every N-th load step (implies --vtk).
+    /// With --vtk, also write every N-th load step (implies --vtk; column and cantilever;
+    /// the compaction writes its initial and final states only).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     vtk_every: Option<u32>,
 }
@@ -131,7 +133,35 @@ fn run_plane(file: &Path, cli: &Cli) -> Result<Option<bool>, StudyError> {
     };
     let tier = if cli.quick { Tier::Quick } else { Tier::Full };
     let start = Instant::now();
-    let (dir, summary, files) = plane::run_file(file, &text, &problem, tier, &cli.out, cli.render_only)?;
+    let bar = progress(0);
+    bar.set_prefix(problem.clone());
+    let on_start = |n: usize| bar.set_length(n as u64);
+    let on_done = |id: &str, status: CaseStatus| {
+        if status != CaseStatus::Converged {
+            bar.set_message(format!("{id} {status:?}"));
+        }
+        bar.inc(1);
+    };
+    let options = plane::PlaneRunOptions {
+        study_dir: None,
+        resume: cli.resume,
+        vtk: (cli.vtk || cli.vtk_every.is_some()).then(|| VtkOptions {
+            every: cli.vtk_every.map_or(0, |n| n as usize),
+        }),
+        on_start: &on_start,
+        on_done: &on_done,
+    };
+    let ran = plane::run_file(file, &text, &problem, tier, &cli.out, cli.render_only, options);
+    bar.finish_and_clear();
+    let (dir, summary, files) = ran?;
+    if let Some(r) = summary.as_ref().filter(|_| cli.resume) {
+        eprintln!(
+            "{problem}: resumed {} of {} cases from {}",
+            r.resumed,
+            r.cases,
+            dir.join("cases").display()
+        );
+    }
     if let Some(r) = summary {
         eprintln!(
             "{problem}: {} cases ({} failed, {} rejected) solved and {} files rendered into {} in {:.2} s",

@@ -17,6 +17,7 @@ use super::plane::{
     IndexEntry, PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
 };
 use super::runner::{CaseStatus, FailureRecord, StepRecord};
+use super::vtk_output::{write_domain_frames, DomainFrame};
 use super::{NewtonSection, StudyError, Tier};
 use crate::constitutive::LinearElastic;
 use crate::error::SolveError;
@@ -558,6 +559,8 @@ impl CantileverResults {
 pub struct CantileverRun {
     pub results: CantileverResults,
     pub snapshots: BTreeMap<String, Vec<DomainSnapshot>>,
+    /// Cases read back from the case store (`--resume`).
+    pub resumed: usize,
 }
 
 impl CantileverRun {
@@ -643,7 +646,11 @@ fn solve_fem_q8(spec: &CantileverSpec) -> Result<CaseOutcome, String> {
     Ok(out)
 }
 
-fn solve_case(case: &CantileverCase) -> (CantileverRecord, Vec<DomainSnapshot>) {
+/// Solve one case, taking domain snapshots every `snapshot_every` steps (0: none).
+fn solve_case_snapshots(
+    case: &CantileverCase,
+    snapshot_every: usize,
+) -> (CantileverRecord, Vec<DomainSnapshot>) {
     let s = &case.spec;
     let igimp = case.method == PlaneMethod::Igimp;
     let mut rec = CantileverRecord {
@@ -670,7 +677,7 @@ fn solve_case(case: &CantileverCase) -> (CantileverRecord, Vec<DomainSnapshot>) 
         steps: vec![],
     };
     let outcome = match case.method {
-        PlaneMethod::Igimp => solve_mpm(s, case.snapshot_every)
+        PlaneMethod::Igimp => solve_mpm(s, snapshot_every)
             .map_err(|e| e.to_string())
             .map(|o| CaseOutcome {
                 steps: o.steps,
@@ -874,11 +881,66 @@ fn depth_rows(study: &CantileverStudy, records: &[CantileverRecord]) -> Vec<Dept
 
 /// Solve every case of the tier.
 pub fn run_study(study: &CantileverStudy, study_file: &str, tier: Tier) -> CantileverRun {
+    run_study_with(study, study_file, tier, &plane::PlaneRunOptions::default())
+        .expect("no case store, nothing to fail")
+}
+
+/// ParaView files of an iGIMP case: its domain snapshots (the initial state, every
+/// `--vtk-every` steps or the figure's interval, and the last converged step).
+fn write_case_vtk(
+    dir: &Path,
+    case: &CantileverCase,
+    out: &(CantileverRecord, Vec<DomainSnapshot>),
+) -> Result<(), StudyError> {
+    let frames: Vec<DomainFrame> = out
+        .1
+        .iter()
+        .map(|s| DomainFrame {
+            time: s.step as f64 / case.spec.load_steps.max(1) as f64,
+            step: s.step,
+            domains: s.domains.clone(),
+            scalars: vec![],
+        })
+        .collect();
+    write_domain_frames(dir, &case.id, &frames).map(|_| ())
+}
+
+/// [`run_study`] with the case store, `--resume`, `--vtk` and progress of `options`.
+pub fn run_study_with(
+    study: &CantileverStudy,
+    study_file: &str,
+    tier: Tier,
+    options: &plane::PlaneRunOptions<'_>,
+) -> Result<CantileverRun, StudyError> {
     let start = std::time::Instant::now();
     let cases = study.cases(tier);
     let cost =
         |c: &CantileverCase| (c.spec.length / c.spec.element_size) * (c.spec.points_per_cell as f64).powi(2);
-    let solved = plane::run_cases(&cases, cost, solve_case);
+    let key = |c: &CantileverCase| plane::case_key(&c.id, c.method, &c.spec, c.snapshot_every);
+    // With --vtk every iGIMP case takes snapshots: its figure's interval, else --vtk-every,
+    // else only the initial and final states.
+    let solve = |c: &CantileverCase| {
+        let every = match options.vtk {
+            Some(v) if c.snapshot_every == 0 => {
+                if v.every > 0 {
+                    v.every
+                } else {
+                    c.spec.load_steps
+                }
+            }
+            _ => c.snapshot_every,
+        };
+        solve_case_snapshots(c, every)
+    };
+    let (solved, resumed) = plane::run_cases_stored(
+        &cases,
+        key,
+        cost,
+        solve,
+        |(r, _): &(CantileverRecord, Vec<DomainSnapshot>)| r.status,
+        write_case_vtk,
+        options,
+    )?;
     let mut records = vec![];
     let mut snapshots = BTreeMap::new();
     let mut times = BTreeMap::new();
@@ -909,7 +971,11 @@ pub fn run_study(study: &CantileverStudy, study_file: &str, tier: Tier) -> Canti
     };
     results.checks = compute_checks(&results);
     results.timing.wall_seconds = start.elapsed().as_secs_f64();
-    CantileverRun { results, snapshots }
+    Ok(CantileverRun {
+        results,
+        snapshots,
+        resumed,
+    })
 }
 
 /// Write `<out>/<name>/results.json` and `domains.json`; returns the folder.

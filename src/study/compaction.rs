@@ -14,6 +14,7 @@ use super::plane::{
     IndexEntry, PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
 };
 use super::runner::{CaseStatus, FailureRecord, StepRecord};
+use super::vtk_output::{write_domain_frames, DomainFrame};
 use super::{NewtonSection, StudyError, Tier};
 use crate::error::SolveError;
 use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads};
@@ -624,6 +625,8 @@ impl CompactionResults {
 pub struct CompactionRun {
     pub results: CompactionResults,
     pub domains: BTreeMap<String, Vec<DomainRecord>>,
+    /// Cases read back from the case store (`--resume`).
+    pub resumed: usize,
 }
 
 impl CompactionRun {
@@ -979,13 +982,69 @@ fn relative_spread(u: &[f64]) -> Option<f64> {
 
 /// Solve every case of the tier.
 pub fn run_study(study: &CompactionStudy, study_file: &str, tier: Tier) -> CompactionRun {
+    run_study_with(study, study_file, tier, &plane::PlaneRunOptions::default())
+        .expect("no case store, nothing to fail")
+}
+
+/// ParaView files of an iGIMP case: the initial domains and those of the last converged step
+/// (σyy and the plastic multiplier as cell data).
+fn write_case_vtk(
+    dir: &Path,
+    case: &CompactionCase,
+    out: &(CompactionRecord, Vec<DomainRecord>),
+) -> Result<(), StudyError> {
+    let (rec, doms) = out;
+    let initial = DomainFrame {
+        time: 0.0,
+        step: 0,
+        domains: doms
+            .iter()
+            .map(|d| [d.x0[0], d.x0[1], d.half0[0], d.half0[1]])
+            .collect(),
+        scalars: vec![],
+    };
+    let steps = rec.steps.len();
+    let last = DomainFrame {
+        time: steps as f64 / case.spec.load_steps.max(1) as f64,
+        step: steps,
+        domains: doms
+            .iter()
+            .map(|d| [d.x[0], d.x[1], d.half[0], d.half[1]])
+            .collect(),
+        scalars: vec![
+            ("sigma_yy".into(), doms.iter().map(|d| d.sigma_yy).collect()),
+            (
+                "plastic_multiplier".into(),
+                doms.iter().map(|d| d.plastic_multiplier).collect(),
+            ),
+        ],
+    };
+    write_domain_frames(dir, &case.id, &[initial, last]).map(|_| ())
+}
+
+/// [`run_study`] with the case store, `--resume`, `--vtk` and progress of `options`.
+pub fn run_study_with(
+    study: &CompactionStudy,
+    study_file: &str,
+    tier: Tier,
+    options: &plane::PlaneRunOptions<'_>,
+) -> Result<CompactionRun, StudyError> {
     let start = std::time::Instant::now();
     let (cases, sweep_cases) = study.cases(tier);
     let cost = |c: &CompactionCase| {
         let s = &c.spec;
         (s.points_per_cell * s.points_per_cell) as f64 / (s.element_size * s.element_size)
     };
-    let solved = plane::run_cases(&cases, cost, solve_case);
+    let key = |c: &CompactionCase| plane::case_key(&c.id, c.method, &c.spec, 0);
+    let (solved, resumed) = plane::run_cases_stored(
+        &cases,
+        key,
+        cost,
+        solve_case,
+        |(r, _): &(CompactionRecord, Vec<DomainRecord>)| r.status,
+        write_case_vtk,
+        options,
+    )?;
     let drawn: BTreeSet<String> = study
         .figures
         .iter()
@@ -1028,7 +1087,11 @@ pub fn run_study(study: &CompactionStudy, study_file: &str, tier: Tier) -> Compa
     results.reference = figure17_reference(&results);
     results.checks = compute_checks(&results);
     results.timing.wall_seconds = start.elapsed().as_secs_f64();
-    CompactionRun { results, domains }
+    Ok(CompactionRun {
+        results,
+        domains,
+        resumed,
+    })
 }
 
 /// Write `<out>/<name>/results.json` and `domains.json`; returns the folder.

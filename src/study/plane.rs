@@ -5,7 +5,8 @@
 //! [`crate::report::render_index`] dispatch on that key ([`problem_of_study`],
 //! [`problem_of_results`]) and otherwise use the column study's conventions: compute →
 //! `results.json` → render, rayon across cases with the records in study order, failed cases
-//! recorded with their step, reason and residuals, `--quick`, `--render-only`, `--check`.
+//! recorded with their step, reason and residuals, `--quick`, `--render-only`, `--check`, the
+//! case store with `--resume`, `--vtk` and the progress bar ([`run_cases_stored`]).
 //!
 //! `results.json` holds no wall-clock data except its `timing` block, so two runs compare
 //! equal after [`Timing::zeroed`]. The material point domains drawn in the figures are kept
@@ -212,6 +213,136 @@ pub fn run_cases<C: Sync, R: Send>(
         .collect();
     solved.sort_by_key(|s| s.0);
     solved.into_iter().map(|(_, r, t)| (r, t)).collect()
+}
+
+/// What the `study` binary asks of a plane-strain run besides the tier: the case store
+/// (`<out>/<name>/cases/`, every finished case written atomically as soon as it is done),
+/// `--resume`, `--vtk` and the progress bar.
+pub struct PlaneRunOptions<'a> {
+    /// The study's output folder; `None`: no case store and no VTK (the library's
+    /// `run_study`).
+    pub study_dir: Option<PathBuf>,
+    /// Reuse the stored record of a case whose inputs hash equally.
+    pub resume: bool,
+    /// Write ParaView files of the material point domains of each iGIMP case.
+    pub vtk: Option<super::vtk_output::VtkOptions>,
+    /// Called once with the number of cases, then with each case's id and status when done.
+    pub on_start: &'a (dyn Fn(usize) + Sync),
+    pub on_done: &'a (dyn Fn(&str, CaseStatus) + Sync),
+}
+
+impl Default for PlaneRunOptions<'_> {
+    fn default() -> Self {
+        Self {
+            study_dir: None,
+            resume: false,
+            vtk: None,
+            on_start: &|_| {},
+            on_done: &|_, _| {},
+        }
+    }
+}
+
+/// The inputs that define a plane-strain case's result, hashed for `--resume`.
+#[derive(Serialize)]
+struct CaseDefinition<'a, S> {
+    id: &'a str,
+    method: PlaneMethod,
+    spec: &'a S,
+    /// Domain snapshots taken for the figures (0: none).
+    snapshot_every: usize,
+}
+
+/// The store key of a case for [`run_cases_stored`]: its id, the hash of its definition, and
+/// whether it has VTK output (iGIMP cases).
+pub fn case_key<S: Serialize>(
+    id: &str,
+    method: PlaneMethod,
+    spec: &S,
+    snapshot_every: usize,
+) -> (String, String, bool) {
+    let def = CaseDefinition {
+        id,
+        method,
+        spec,
+        snapshot_every,
+    };
+    (
+        id.to_string(),
+        super::store::case_hash(&def),
+        method == PlaneMethod::Igimp,
+    )
+}
+
+/// A finished case as the store keeps it: its output and the seconds it took (so that a
+/// resumed run reports the original timing).
+#[derive(Serialize, Deserialize)]
+struct StoredCase<R> {
+    output: R,
+    seconds: f64,
+}
+
+/// [`run_cases`] with the case store: with `resume`, a case stored earlier under the same id
+/// and input hash (`key` gives both, and whether the case has VTK output; with `--vtk`, its
+/// `.pvd` must exist too) is read back
+/// instead of solved; every solved case is stored as soon as it is done, and `vtk` (if on)
+/// writes its ParaView files. Returns the outputs in case order with their seconds, and how
+/// many were resumed; the first store error (in case order) fails the run.
+#[allow(clippy::too_many_arguments)]
+pub fn run_cases_stored<C: Sync, R: Send + Serialize + DeserializeOwned>(
+    cases: &[C],
+    key: impl Fn(&C) -> (String, String, bool) + Sync,
+    cost: impl Fn(&C) -> f64 + Sync,
+    solve: impl Fn(&C) -> R + Sync,
+    status: impl Fn(&R) -> CaseStatus + Sync,
+    vtk: impl Fn(&Path, &C, &R) -> Result<(), StudyError> + Sync,
+    options: &PlaneRunOptions<'_>,
+) -> Result<(Vec<(R, f64)>, usize), StudyError> {
+    (options.on_start)(cases.len());
+    let store = match &options.study_dir {
+        Some(dir) => Some(super::store::CaseStore::open(&dir.join("cases"))?),
+        None => None,
+    };
+    let resumed = std::sync::atomic::AtomicUsize::new(0);
+    let outputs = run_cases(
+        &cases.iter().collect::<Vec<_>>(),
+        |c| cost(c),
+        |c| {
+            let (id, hash, has_vtk) = key(c);
+            let (Some(store), Some(dir)) = (&store, &options.study_dir) else {
+                let r = solve(c);
+                (options.on_done)(&id, status(&r));
+                return Ok((r, None));
+            };
+            let vtk_done = match options.vtk {
+                Some(_) if has_vtk => super::vtk_output::pvd_path(dir, &id)?.exists(),
+                _ => true,
+            };
+            if options.resume && vtk_done {
+                if let Some(s) = store.load::<StoredCase<R>>(&id, &hash) {
+                    resumed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    (options.on_done)(&id, status(&s.output));
+                    return Ok((s.output, Some(s.seconds)));
+                }
+            }
+            let t = Instant::now();
+            let r = solve(c);
+            let seconds = t.elapsed().as_secs_f64();
+            if options.vtk.is_some() && has_vtk {
+                vtk(dir, c, &r)?;
+            }
+            let stored = StoredCase { output: r, seconds };
+            store.save(&id, &hash, &stored)?;
+            (options.on_done)(&id, status(&stored.output));
+            Ok((stored.output, Some(seconds)))
+        },
+    );
+    let mut out = Vec::with_capacity(outputs.len());
+    for (r, secs) in outputs {
+        let (r, stored_secs) = r?;
+        out.push((r, stored_secs.unwrap_or(secs)));
+    }
+    Ok((out, resumed.into_inner()))
 }
 
 /// Residual histories of converged load steps.
@@ -531,6 +662,8 @@ pub struct RunSummary {
     pub failed: usize,
     pub rejected: usize,
     pub checks: (usize, usize, usize),
+    /// Cases read back from the case store (`--resume`).
+    pub resumed: usize,
 }
 
 impl RunSummary {
@@ -540,6 +673,7 @@ impl RunSummary {
             failed: 0,
             rejected: 0,
             checks: check_counts(checks),
+            resumed: 0,
         };
         for s in statuses {
             r.cases += 1;
@@ -548,10 +682,17 @@ impl RunSummary {
         }
         r
     }
+
+    pub fn with_resumed(mut self, resumed: usize) -> Self {
+        self.resumed = resumed;
+        self
+    }
 }
 
 /// Solve (unless `render_only`) and render the plane-strain study in `file`, whose text and
-/// problem are given. Returns the study's output folder and its summary.
+/// problem are given, with the case store, `--resume`, `--vtk` and progress of `options`
+/// (its `study_dir` is set here: `<out>/<name>`). Returns the study's output folder, its
+/// summary and the rendered files.
 pub fn run_file(
     file: &Path,
     text: &str,
@@ -559,6 +700,7 @@ pub fn run_file(
     tier: Tier,
     out: &Path,
     render_only: bool,
+    options: PlaneRunOptions<'_>,
 ) -> Result<(PathBuf, Option<RunSummary>, Vec<PathBuf>), StudyError> {
     let file_name = file.file_name().map_or_else(
         || file.display().to_string(),
@@ -572,9 +714,13 @@ pub fn run_file(
             let summary = if render_only {
                 None
             } else {
-                let run = super::compaction::run_study(&spec, &file_name, tier);
+                let options = PlaneRunOptions {
+                    study_dir: Some(dir.clone()),
+                    ..options
+                };
+                let run = super::compaction::run_study_with(&spec, &file_name, tier, &options)?;
                 super::compaction::write_outputs(out, &run)?;
-                Some(run.summary())
+                Some(run.summary().with_resumed(run.resumed))
             };
             (dir, summary)
         }
@@ -584,9 +730,13 @@ pub fn run_file(
             let summary = if render_only {
                 None
             } else {
-                let run = super::cantilever::run_study(&spec, &file_name, tier);
+                let options = PlaneRunOptions {
+                    study_dir: Some(dir.clone()),
+                    ..options
+                };
+                let run = super::cantilever::run_study_with(&spec, &file_name, tier, &options)?;
                 super::cantilever::write_outputs(out, &run)?;
-                Some(run.summary())
+                Some(run.summary().with_resumed(run.resumed))
             };
             (dir, summary)
         }

@@ -26,6 +26,16 @@ pub fn vtk_dir(study_dir: &Path) -> PathBuf {
     study_dir.join("vtk")
 }
 
+/// `<study_dir>/vtk/<case_id>/`, emptied of an earlier run's files.
+fn fresh_case_dir(study_dir: &Path, case_id: &str) -> Result<PathBuf, StudyError> {
+    let case_dir = confined(&vtk_dir(study_dir), case_id)?;
+    if case_dir.exists() {
+        std::fs::remove_dir_all(&case_dir).map_err(|e| StudyError::io(&case_dir, e))?;
+    }
+    std::fs::create_dir_all(&case_dir).map_err(|e| StudyError::io(&case_dir, e))?;
+    Ok(case_dir)
+}
+
 /// `.pvd` file of a case.
 pub fn pvd_path(study_dir: &Path, case_id: &str) -> Result<PathBuf, StudyError> {
     confined(&vtk_dir(study_dir), &format!("{case_id}.pvd"))
@@ -55,14 +65,9 @@ impl ColumnVtkWriter {
         load_steps: usize,
         options: VtkOptions,
     ) -> Result<Self, StudyError> {
-        let root = vtk_dir(study_dir);
-        let case_dir = confined(&root, case_id)?;
-        if case_dir.exists() {
-            std::fs::remove_dir_all(&case_dir).map_err(|e| StudyError::io(&case_dir, e))?;
-        }
-        std::fs::create_dir_all(&case_dir).map_err(|e| StudyError::io(&case_dir, e))?;
+        let case_dir = fresh_case_dir(study_dir, case_id)?;
         Ok(Self {
-            root,
+            root: vtk_dir(study_dir),
             case_id: case_id.to_string(),
             case_dir,
             load_steps: load_steps.max(1),
@@ -144,4 +149,77 @@ impl ColumnVtkWriter {
         vtk::write_pvd(&path, &self.entries).map_err(|e| StudyError::io(&path, e))?;
         Ok(path)
     }
+}
+
+/// One frame of a plane-strain case for ParaView: material point domains (centre and
+/// half-lengths) at `time` (the load factor), with per-point scalars.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DomainFrame {
+    pub time: f64,
+    pub step: usize,
+    /// (x, y, half-length x, half-length y) per point.
+    pub domains: Vec<[f64; 4]>,
+    pub scalars: Vec<(String, Vec<f64>)>,
+}
+
+/// The domains of a frame as quadrilaterals (cell `p` is point `p`'s domain, its scalars as
+/// cell data), so that ParaView draws the GIMP domains as the paper's figures do.
+pub fn domains_grid(frame: &DomainFrame) -> UnstructuredGrid {
+    let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+    let mut pts = Vec::with_capacity(4 * frame.domains.len());
+    for d in &frame.domains {
+        for (sx, sy) in corners {
+            pts.push([d[0] + sx * d[2], d[1] + sy * d[3], 0.0]);
+        }
+    }
+    let mut g = UnstructuredGrid {
+        points: pts,
+        ..UnstructuredGrid::default()
+    };
+    for p in 0..frame.domains.len() {
+        g.push_cell(vtk::cell::QUAD, &[4 * p, 4 * p + 1, 4 * p + 2, 4 * p + 3]);
+    }
+    let cell = |name: &str, components: usize, values: Vec<f64>| vtk::DataArray {
+        name: name.to_string(),
+        components,
+        values,
+    };
+    g.cell_data.push(cell(
+        "centre",
+        3,
+        frame.domains.iter().flat_map(|d| [d[0], d[1], 0.0]).collect(),
+    ));
+    g.cell_data.push(cell(
+        "half_length",
+        3,
+        frame.domains.iter().flat_map(|d| [d[2], d[3], 0.0]).collect(),
+    ));
+    for (name, values) in &frame.scalars {
+        g.cell_data.push(cell(name, 1, values.clone()));
+    }
+    g
+}
+
+/// Write `<study_dir>/vtk/<case_id>.pvd` and one `.vtu` per frame (`<case_id>/domains_<step>.vtu`),
+/// replacing stale files of the case.
+pub fn write_domain_frames(
+    study_dir: &Path,
+    case_id: &str,
+    frames: &[DomainFrame],
+) -> Result<PathBuf, StudyError> {
+    let case_dir = fresh_case_dir(study_dir, case_id)?;
+    let mut entries = vec![];
+    for f in frames {
+        let name = format!("domains_{:05}.vtu", f.step);
+        let path = case_dir.join(&name);
+        vtk::write_vtu(&path, &domains_grid(f)).map_err(|e| StudyError::io(&path, e))?;
+        entries.push(PvdEntry {
+            time: f.time,
+            part: 0,
+            file: format!("{case_id}/{name}"),
+        });
+    }
+    let path = pvd_path(study_dir, case_id)?;
+    vtk::write_pvd(&path, &entries).map_err(|e| StudyError::io(&path, e))?;
+    Ok(path)
 }
