@@ -7,7 +7,7 @@
 //! associative perfect plasticity with its consistent tangent, is symmetric, so
 //! [`LinearSolver::Ldlt`] or [`LinearSolver::Llt`] may be chosen instead: they read only
 //! the lower triangle, need about half the fill and run several times faster (measured in
-//! `tests/fem2d.rs`). If the symmetric factorisation fails (zero pivot; for LLT any matrix
+//! `tests/verification/fem2d.rs`). If the symmetric factorisation fails (zero pivot; for LLT any matrix
 //! that is not numerically positive definite) or yields a non-finite solution, the same
 //! system is solved by LU and the fallback is counted ([`SparseSystem::fallbacks`]).
 

@@ -45,7 +45,7 @@ pub const MAX_ALPHA: f64 = 1.0e4;
 pub const SHOOTING_MAX_ALPHA: f64 = 300.0;
 
 /// Default number of RK4 steps on s ∈ [0, 1] for [`tip_shooting`]; agreement with the elliptic
-/// solution is better than 1e-10 for α ≤ 20 (tests/elastica.rs).
+/// solution is better than 1e-10 for α ≤ 20 (tests/verification/elastica.rs).
 pub const SHOOTING_STEPS: usize = 4000;
 
 /// Tip response of the end-loaded elastica (see the module doc for signs).

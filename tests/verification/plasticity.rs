@@ -2,7 +2,7 @@
 //! the elasto-plastic column against the analytical solution derived in
 //! `problems::column::AnalyticalColumn`, and Newton's convergence on it.
 
-mod common;
+use crate::common;
 
 use common::Rng;
 use igimp::basis::Basis;

@@ -149,7 +149,7 @@ fn weak_node_treatment_is_needed_and_insensitive_to_its_tolerance() {
 
 /// One point per cell in 2D integrates each element at one point (hourglass modes): without
 /// the ghost penalty Newton fails, and the failure is a recorded case with its step and
-/// residuals, not a panic (with it, see tests/robustness.rs and the compaction study).
+/// residuals, not a panic (with it, see tests/verification/robustness.rs and the compaction study).
 #[test]
 fn one_point_per_cell_failure_is_recorded() {
     let o = solve_mpm(&CompactionSpec {

@@ -2,7 +2,7 @@
 //! and the assembled global tangent (eqs 25, 27, 36) against differences of the global
 //! residual, in 1D and 2D, at non-trivial deformed states. Also objectivity of the update.
 
-mod common;
+use crate::common;
 
 use common::Rng;
 use igimp::assembly::{DofMap, LoadStepSystem};

@@ -2,7 +2,7 @@
 //! zero gradient sum, linear reproduction, the per-element split of eqs (7)–(10) against the
 //! closed-form GIMP weight, and continuity across element edges.
 
-mod common;
+use crate::common;
 
 use common::Rng;
 use igimp::basis::{gimp_element_weights, AxisWeights, Basis, GridAxis, Support};

@@ -9,7 +9,7 @@
 // Index loops mirror the index notation (N_a, ∂N_a/∂ξ_d).
 #![allow(clippy::needless_range_loop)]
 
-mod common;
+use crate::common;
 
 use common::Rng;
 use igimp::constitutive::{ConstitutiveModel, LinearElastic, VonMises};

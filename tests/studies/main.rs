@@ -1,0 +1,7 @@
+//! The study harness end to end: study files, the tiers of every study, re-rendering byte
+//! for byte, resume, ParaView output and thread-count independence. One test binary.
+
+mod cantilever_study;
+mod compaction_study;
+mod study;
+mod usability;

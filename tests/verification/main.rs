@@ -1,0 +1,18 @@
+//! Verification of the library, one module per topic: weight invariants, finite-difference
+//! tangents, patch tests, constitutive checks, the FEM comparators, the paper's column and
+//! compaction results, robustness and hostile input. One test binary (fenris's split), so that
+//! the crate is linked once for all of them.
+
+mod common;
+
+mod basis;
+mod column;
+mod compaction;
+mod elastica;
+mod fem;
+mod fem2d;
+mod hostile;
+mod patch;
+mod plasticity;
+mod robustness;
+mod tangent;
