@@ -36,6 +36,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod assembly;
+pub mod atomic_file;
 pub mod basis;
 pub mod constitutive;
 pub mod error;

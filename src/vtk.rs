@@ -15,11 +15,11 @@
 //! VTK File Formats, "XML File Formats" (Kitware, VTK User's Guide §19); ParaView's `.pvd`
 //! collection format.
 
+use crate::atomic_file::write_atomic;
 use crate::fem::{LineElement, LineMesh};
 use crate::grid::Grid;
 use crate::kinematics::PointState;
 use crate::particles::MaterialPoints;
-use crate::study::store::write_atomic;
 use nalgebra::{Matrix3, SVector};
 use std::fmt::Write as _;
 use std::path::Path;

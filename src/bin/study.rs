@@ -10,7 +10,7 @@ use igimp::study::runner::{
     read_results, run_study_in, study_dir, write_outputs, CaseRecord, CaseStatus, RunOptions,
 };
 use igimp::study::vtk_output::VtkOptions;
-use igimp::study::{plane, study_files, StudyError, StudySpec, Tier};
+use igimp::study::{plane, registry, study_files, StudyError, StudySpec, Tier};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -75,7 +75,8 @@ fn catalogue(dir: &Path) -> Vec<Result<(String, String), StudyError>> {
         Ok(files) => files
             .iter()
             .map(|f| {
-                plane::catalogue_entry(f).unwrap_or_else(|| StudySpec::load(f).map(|s| (s.name, s.summary)))
+                registry::catalogue_entry(f)
+                    .unwrap_or_else(|| StudySpec::load(f).map(|s| (s.name, s.summary)))
             })
             .collect(),
         Err(e) => vec![Err(e)],
@@ -151,7 +152,7 @@ fn run_plane(file: &Path, cli: &Cli) -> Result<Option<bool>, StudyError> {
         on_start: &on_start,
         on_done: &on_done,
     };
-    let ran = plane::run_file(file, &text, &problem, tier, &cli.out, cli.render_only, options);
+    let ran = registry::run_file(file, &text, &problem, tier, &cli.out, cli.render_only, options);
     bar.finish_and_clear();
     let (dir, summary, files) = ran?;
     if let Some(r) = summary.as_ref().filter(|_| cli.resume) {
@@ -173,7 +174,7 @@ fn run_plane(file: &Path, cli: &Cli) -> Result<Option<bool>, StudyError> {
             start.elapsed().as_secs_f64()
         );
     }
-    let (pass, fail, none) = plane::folder_check_counts(&dir)?;
+    let (pass, fail, none) = registry::folder_check_counts(&dir)?;
     eprintln!("{problem}: checks: {pass} passed, {fail} failed, {none} not evaluated");
     Ok(Some(fail == 0 && none == 0))
 }

@@ -60,7 +60,6 @@ use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_finite, InputError, StepFailure};
 use crate::newton::{Increment, LoadStepping, NewtonSettings};
-use crate::problems::column::{ColumnObserver, ColumnOutcome, ColumnSpec, ColumnState, PointRecord};
 use crate::quadrature::GaussRule;
 use nalgebra::SVector;
 use updated_lagrangian::{fem_advance, fem_step_system, UlCore};
@@ -234,69 +233,4 @@ impl LoadStepping for LineFem {
     fn load_steps(&self) -> usize {
         self.settings.load_steps
     }
-}
-
-impl ColumnSpec {
-    /// The FEM solver for this column: `elements` equal elements on [0, L0], base node fixed,
-    /// gravity along −z, `gauss_points` (default: the element's) per element.
-    pub fn fem_solver(&self, element: LineElement) -> Result<LineFem, InputError> {
-        self.validate()?;
-        let mesh = LineMesh::uniform(element, 0.0, self.length, self.elements)?;
-        let model = self.model()?;
-        let loads = LineLoads {
-            gravity: -self.gravity(),
-            nodal_forces: vec![],
-        };
-        let settings = LineFemSettings {
-            gauss_points: self.gauss_points.unwrap_or(element.default_gauss_points()),
-            newton: self.newton,
-            load_steps: self.load_steps,
-        };
-        LineFem::try_new(mesh, self.density, model, vec![0], loads, settings)
-    }
-}
-
-/// Run the column with updated-Lagrangian FEM. Records one [`PointRecord`] per Gauss point
-/// (their initial volumes weight eq 46); the top displacement is that of the top node and the
-/// base F that of the bottom-most Gauss point (eq 47), through the same
-/// [`ColumnOutcome::from_records`] as the material point methods.
-pub fn solve_column(spec: &ColumnSpec, element: LineElement) -> Result<ColumnOutcome, InputError> {
-    solve_column_observed(spec, element, &mut |_, _| {})
-}
-
-/// [`solve_column`] showing the solver to `observer` before the first and after every
-/// converged load step.
-pub fn solve_column_observed(
-    spec: &ColumnSpec,
-    element: LineElement,
-    observer: &mut ColumnObserver<'_>,
-) -> Result<ColumnOutcome, InputError> {
-    let mut solver = spec.fem_solver(element)?;
-    observer(0, ColumnState::Fem(&solver));
-    let (steps, failure) = match solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Fem(s))) {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
-    let records = column_records(&solver);
-    let top = solver.displacement(solver.mesh.num_nodes() - 1);
-    Ok(ColumnOutcome::from_records(spec, records, top, steps, failure))
-}
-
-/// Final values at every Gauss point.
-pub fn column_records(solver: &LineFem) -> Vec<PointRecord> {
-    let g = &solver.gauss;
-    (0..g.len())
-        .map(|p| {
-            let sigma = g.state[p].cauchy();
-            PointRecord {
-                z0: g.position0[p],
-                z: solver.gauss_point_map(p).0,
-                volume0: g.volume0[p],
-                sigma_zz: sigma[(0, 0)],
-                sigma_xx: sigma[(1, 1)],
-                f_zz: g.state[p].f[(0, 0)],
-                plastic_multiplier: g.state[p].material.plastic_multiplier,
-            }
-        })
-        .collect()
 }

@@ -7,6 +7,7 @@
 use crate::basis::Basis;
 use crate::constitutive::{lame, ConstitutiveModel, LinearElastic};
 use crate::error::{require_count, require_positive, InputError, SolveError};
+use crate::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
 use crate::ghost::GhostSettings;
 use crate::grid::Grid;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
@@ -513,7 +514,7 @@ impl ColumnOutcome {
 #[derive(Clone, Copy)]
 pub enum ColumnState<'a> {
     Mpm(&'a MpmSolver<1>),
-    Fem(&'a crate::fem::LineFem),
+    Fem(&'a LineFem),
 }
 
 /// Called with the load step number (0 before the first step) and the solver after the
@@ -532,12 +533,11 @@ pub fn solve_column_observed(
     method: Method,
     observer: &mut ColumnObserver<'_>,
 ) -> Result<ColumnOutcome, InputError> {
-    use crate::fem::LineElement;
     match method {
         Method::Mpm => solve_mpm_observed(spec, Basis::Mpm, observer),
         Method::Igimp => solve_mpm_observed(spec, Basis::Gimp, observer),
-        Method::FemLinear => crate::fem::solve_column_observed(spec, LineElement::Linear, observer),
-        Method::FemQuadratic => crate::fem::solve_column_observed(spec, LineElement::Quadratic, observer),
+        Method::FemLinear => solve_fem_observed(spec, LineElement::Linear, observer),
+        Method::FemQuadratic => solve_fem_observed(spec, LineElement::Quadratic, observer),
     }
 }
 
@@ -577,4 +577,69 @@ fn solve_mpm_observed(
         .max_by(|&a, &b| pts.position0[a][0].total_cmp(&pts.position0[b][0]))
         .map_or(f64::NAN, |p| pts.displacement(p)[0]);
     Ok(ColumnOutcome::from_records(spec, records, top, steps, failure))
+}
+
+impl ColumnSpec {
+    /// The FEM solver for this column: `elements` equal elements on [0, L0], base node fixed,
+    /// gravity along −z, `gauss_points` (default: the element's) per element.
+    pub fn fem_solver(&self, element: LineElement) -> Result<LineFem, InputError> {
+        self.validate()?;
+        let mesh = LineMesh::uniform(element, 0.0, self.length, self.elements)?;
+        let model = self.model()?;
+        let loads = LineLoads {
+            gravity: -self.gravity(),
+            nodal_forces: vec![],
+        };
+        let settings = LineFemSettings {
+            gauss_points: self.gauss_points.unwrap_or(element.default_gauss_points()),
+            newton: self.newton,
+            load_steps: self.load_steps,
+        };
+        LineFem::try_new(mesh, self.density, model, vec![0], loads, settings)
+    }
+}
+
+/// Run the column with updated-Lagrangian FEM. Records one [`PointRecord`] per Gauss point
+/// (their initial volumes weight eq 46); the top displacement is that of the top node and the
+/// base F that of the bottom-most Gauss point (eq 47), through the same
+/// [`ColumnOutcome::from_records`] as the material point methods.
+pub fn solve_fem(spec: &ColumnSpec, element: LineElement) -> Result<ColumnOutcome, InputError> {
+    solve_fem_observed(spec, element, &mut |_, _| {})
+}
+
+/// [`solve_fem`] showing the solver to `observer` before the first and after every
+/// converged load step.
+pub fn solve_fem_observed(
+    spec: &ColumnSpec,
+    element: LineElement,
+    observer: &mut ColumnObserver<'_>,
+) -> Result<ColumnOutcome, InputError> {
+    let mut solver = spec.fem_solver(element)?;
+    observer(0, ColumnState::Fem(&solver));
+    let (steps, failure) = match solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Fem(s))) {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    let records = fem_records(&solver);
+    let top = solver.displacement(solver.mesh.num_nodes() - 1);
+    Ok(ColumnOutcome::from_records(spec, records, top, steps, failure))
+}
+
+/// Final values at every Gauss point.
+pub fn fem_records(solver: &LineFem) -> Vec<PointRecord> {
+    let g = &solver.gauss;
+    (0..g.len())
+        .map(|p| {
+            let sigma = g.state[p].cauchy();
+            PointRecord {
+                z0: g.position0[p],
+                z: solver.gauss_point_map(p).0,
+                volume0: g.volume0[p],
+                sigma_zz: sigma[(0, 0)],
+                sigma_xx: sigma[(1, 1)],
+                f_zz: g.state[p].f[(0, 0)],
+                plastic_multiplier: g.state[p].material.plastic_multiplier,
+            }
+        })
+        .collect()
 }

@@ -13,6 +13,7 @@ pub mod cantilever;
 pub mod compaction;
 pub mod plane;
 pub mod rates;
+pub mod registry;
 pub mod runner;
 pub mod store;
 pub mod vtk_output;

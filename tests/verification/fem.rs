@@ -23,7 +23,7 @@ fn heavy_column(elements: usize, gauss_points: Option<usize>) -> ColumnSpec {
 }
 
 fn solve(spec: &ColumnSpec, element: LineElement) -> ColumnOutcome {
-    let out = igimp::fem::solve_column(spec, element).expect("valid spec");
+    let out = igimp::problems::column::solve_fem(spec, element).expect("valid spec");
     assert!(
         out.failure.is_none(),
         "{element:?}, {} elements: {:?}",
@@ -73,7 +73,7 @@ fn fem_column_gauss_points_is_optional_and_validated() {
         };
         let err = spec.validate().unwrap_err();
         assert_eq!(err.field, "gauss_points");
-        assert!(igimp::fem::solve_column(&spec, LineElement::Linear).is_err());
+        assert!(igimp::problems::column::solve_fem(&spec, LineElement::Linear).is_err());
     }
     let bad_mid = LineMesh::try_new(LineElement::Quadratic, vec![0.0, 0.2, 1.0]);
     assert!(bad_mid.unwrap_err().field.contains("mesh element 0"));
