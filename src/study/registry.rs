@@ -9,6 +9,85 @@ use super::plane::{
 use super::{cantilever, compaction, StudyError, Tier};
 use std::path::{Path, PathBuf};
 
+/// A plane-strain study kind: its study file, how a tier is solved and written, and the
+/// folder it renders.
+pub trait PlaneKind: PlaneStudy {
+    type Run;
+    /// The study's `name` (its output folder under `--out`).
+    fn study_name(&self) -> &str;
+    fn run(
+        &self,
+        study_file: &str,
+        tier: Tier,
+        options: &PlaneRunOptions<'_>,
+    ) -> Result<Self::Run, StudyError>;
+    /// Write results.json and the domain file; returns the folder.
+    fn write(out: &Path, run: &Self::Run) -> Result<PathBuf, StudyError>;
+    fn summary(run: &Self::Run) -> RunSummary;
+}
+
+/// Both kinds follow the same module layout: `run_study_with`, `write_outputs`, and a run
+/// with `summary()` and `resumed`.
+macro_rules! plane_kind {
+    ($study:ty, $run:ty, $module:ident) => {
+        impl PlaneKind for $study {
+            type Run = $run;
+            fn study_name(&self) -> &str {
+                &self.name
+            }
+            fn run(
+                &self,
+                study_file: &str,
+                tier: Tier,
+                options: &PlaneRunOptions<'_>,
+            ) -> Result<Self::Run, StudyError> {
+                $module::run_study_with(self, study_file, tier, options)
+            }
+            fn write(out: &Path, run: &Self::Run) -> Result<PathBuf, StudyError> {
+                $module::write_outputs(out, run)
+            }
+            fn summary(run: &Self::Run) -> RunSummary {
+                run.summary().with_resumed(run.resumed)
+            }
+        }
+    };
+}
+
+plane_kind!(compaction::CompactionStudy, compaction::CompactionRun, compaction);
+plane_kind!(cantilever::CantileverStudy, cantilever::CantileverRun, cantilever);
+
+/// What `study` asks of one study file.
+struct Request<'a> {
+    text: &'a str,
+    /// The file as shown in errors.
+    shown: &'a str,
+    /// The file name recorded in results.json.
+    file_name: &'a str,
+    tier: Tier,
+    out: &'a Path,
+    render_only: bool,
+}
+
+/// Parse, and unless `render_only` solve and write, a study of kind `K`; its folder and
+/// summary.
+fn run_kind<K: PlaneKind>(
+    r: &Request<'_>,
+    options: PlaneRunOptions<'_>,
+) -> Result<(PathBuf, Option<RunSummary>), StudyError> {
+    let spec = K::parse(r.text, r.shown)?;
+    let dir = r.out.join(spec.study_name());
+    if r.render_only {
+        return Ok((dir, None));
+    }
+    let options = PlaneRunOptions {
+        study_dir: Some(dir.clone()),
+        ..options
+    };
+    let run = spec.run(r.file_name, r.tier, &options)?;
+    K::write(r.out, &run)?;
+    Ok((dir, Some(K::summary(&run))))
+}
+
 /// Solve (unless `render_only`) and render the plane-strain study in `file`, whose text and
 /// problem are given, with the case store, `--resume`, `--vtk` and progress of `options`
 /// (its `study_dir` is set here: `<out>/<name>`). Returns the study's output folder, its
@@ -27,39 +106,17 @@ pub fn run_file(
         |f| f.to_string_lossy().into_owned(),
     );
     let shown = file.display().to_string();
+    let request = Request {
+        text,
+        shown: &shown,
+        file_name: &file_name,
+        tier,
+        out,
+        render_only,
+    };
     let (dir, summary) = match problem {
-        "compaction" => {
-            let spec = compaction::CompactionStudy::parse(text, &shown)?;
-            let dir = out.join(&spec.name);
-            let summary = if render_only {
-                None
-            } else {
-                let options = PlaneRunOptions {
-                    study_dir: Some(dir.clone()),
-                    ..options
-                };
-                let run = compaction::run_study_with(&spec, &file_name, tier, &options)?;
-                compaction::write_outputs(out, &run)?;
-                Some(run.summary().with_resumed(run.resumed))
-            };
-            (dir, summary)
-        }
-        "cantilever" => {
-            let spec = cantilever::CantileverStudy::parse(text, &shown)?;
-            let dir = out.join(&spec.name);
-            let summary = if render_only {
-                None
-            } else {
-                let options = PlaneRunOptions {
-                    study_dir: Some(dir.clone()),
-                    ..options
-                };
-                let run = cantilever::run_study_with(&spec, &file_name, tier, &options)?;
-                cantilever::write_outputs(out, &run)?;
-                Some(run.summary().with_resumed(run.resumed))
-            };
-            (dir, summary)
-        }
+        "compaction" => run_kind::<compaction::CompactionStudy>(&request, options)?,
+        "cantilever" => run_kind::<cantilever::CantileverStudy>(&request, options)?,
         other => {
             return Err(invalid(
                 &shown,
