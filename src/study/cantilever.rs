@@ -216,7 +216,12 @@ impl PlaneStudy for CantileverStudy {
         let b = &self.beam;
         for (key, v, lo, hi) in [
             ("beam.load_steps", b.load_steps, 1, 10_000),
-            ("beam.points_per_cell", b.points_per_cell, 1, 16),
+            (
+                "beam.points_per_cell",
+                b.points_per_cell,
+                1,
+                super::max_points_per_axis(2),
+            ),
             ("newton.max_iterations", self.newton.max_iterations, 1, 1000),
         ] {
             if !(lo..=hi).contains(&v) {
@@ -235,7 +240,7 @@ impl PlaneStudy for CantileverStudy {
                     file,
                     format!("cases[{i}].id"),
                     &c.id,
-                    "must be a unique [a-z0-9_.-] name",
+                    format!("must be a unique identifier ({})", super::IDENT_RULE),
                 ));
             }
             if c.method == PlaneMethod::FemQ4 {

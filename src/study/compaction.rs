@@ -279,7 +279,7 @@ impl PlaneStudy for CompactionStudy {
                     file,
                     format!("sweeps[{i}].id"),
                     &s.id,
-                    "must be a unique [a-z0-9_-] name",
+                    format!("must be a unique identifier ({})", super::IDENT_RULE),
                 ));
             }
             for tier in [Tier::Full, Tier::Quick] {
@@ -300,12 +300,16 @@ impl PlaneStudy for CompactionStudy {
                         return Err(invalid(file, k(key), "[]", "must list at least one value"));
                     }
                 }
-                if let Some(&p) = plan.points_per_cell.iter().find(|&&p| !(1..=16).contains(&p)) {
+                let max = super::max_points_per_axis(2);
+                if let Some(&p) = plan.points_per_cell.iter().find(|&&p| !(1..=max).contains(&p)) {
                     return Err(invalid(
                         file,
                         k("points_per_cell"),
                         p,
-                        "must be integers in 1..=16",
+                        format!(
+                            "must be integers in 1..={max} (per axis: at most {} points per cell)",
+                            super::MAX_POINTS_PER_CELL
+                        ),
                     ));
                 }
                 for c in self.sweep_cases(s, &plan) {
@@ -355,7 +359,7 @@ impl PlaneStudy for CompactionStudy {
                     file,
                     format!("paper_residuals[{i}].file"),
                     &p.file,
-                    "must be [a-z0-9_-]+.md",
+                    format!("must be a file name <identifier>.md ({})", super::IDENT_RULE),
                 ));
             }
         }
@@ -366,7 +370,7 @@ impl PlaneStudy for CompactionStudy {
                     file,
                     format!("figures[{i}].id"),
                     &f.id,
-                    "must be a unique [a-z0-9_-] name",
+                    format!("must be a unique identifier ({})", super::IDENT_RULE),
                 ));
             }
             sweep_known(format!("figures[{i}].sweep"), &f.sweep)?;
@@ -819,7 +823,7 @@ fn figure17_reference(results: &CompactionResults) -> Option<ReferenceRecord> {
         cases: vec![finest.id.clone()],
         observed_order: None,
         description: format!(
-            "finest iGIMP case (h = {}, {}×{} points per cell) — the 2D FEM comparator is not available yet",
+            "finest iGIMP case (h = {}, {}×{} points per cell): the study has no converged FEM reference sweep",
             finest.h,
             finest.points_per_cell.unwrap_or(0),
             finest.points_per_cell.unwrap_or(0)

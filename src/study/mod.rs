@@ -56,7 +56,8 @@ impl StudyError {
     }
 }
 
-/// Which problem a study solves (only the elastic column of §5.1 so far).
+/// Which problem a column study file solves (the elastic and the plastic column of §5.1; the
+/// plane-strain studies are dispatched by [`registry`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ProblemKind {
@@ -193,7 +194,7 @@ pub struct QuickOverrides {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Sweep {
-    /// Identifier used by expectations and figures ([a-z0-9_-]).
+    /// Identifier used by expectations and figures (see [`ident_ok`]).
     pub id: String,
     /// One line saying what the sweep reproduces.
     pub title: String,
@@ -280,7 +281,7 @@ pub enum FigureKind {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FigureSpec {
-    /// File stem of the SVG ([a-z0-9_-]).
+    /// File stem of the SVG (see [`ident_ok`]).
     pub id: String,
     pub title: String,
     pub kind: FigureKind,
@@ -300,7 +301,7 @@ pub struct FigureSpec {
 pub struct StudySpec {
     /// Layout version; must equal [`SCHEMA_VERSION`].
     pub schema: i64,
-    /// Name of the study and of its output folder ([a-z0-9_-]).
+    /// Name of the study and of its output folder (see [`ident_ok`]).
     pub name: String,
     /// One line for `study list` and `--help`.
     pub summary: String,
@@ -349,11 +350,33 @@ pub struct SweepPlan {
     pub newton: NewtonSettings,
 }
 
-fn valid_ident(s: &str) -> bool {
+/// The one identifier rule of every study file (names, sweep, case and figure ids, report
+/// files): [`IDENT_RULE`]. The leading letter or digit and the ban on `..` keep hidden and
+/// parent paths out, so that an identifier used as a folder or file name stays inside the
+/// output folder.
+pub fn ident_ok(s: &str) -> bool {
     !s.is_empty()
         && s.len() <= 64
+        && s.as_bytes()[0].is_ascii_alphanumeric()
+        && !s.contains("..")
         && s.bytes()
-            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-' || b == b'_')
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || matches!(b, b'-' | b'_' | b'.'))
+}
+
+/// [`ident_ok`] in words, for error messages.
+pub const IDENT_RULE: &str =
+    "1-64 characters from [a-z0-9_.-], starting with a letter or digit, without \"..\"";
+
+/// Most material points per cell of a study case in any dimension (per axis: 64 in 1D, 8 in
+/// 2D, 4 in 3D): beyond it a point's share of a cell is below the quadrature's round-off.
+pub const MAX_POINTS_PER_CELL: i64 = 64;
+
+/// Largest points per cell along each axis in `dim` dimensions ([`MAX_POINTS_PER_CELL`]).
+pub fn max_points_per_axis(dim: u32) -> i64 {
+    (1..=MAX_POINTS_PER_CELL)
+        .take_while(|n| n.pow(dim) <= MAX_POINTS_PER_CELL)
+        .last()
+        .unwrap_or(1)
 }
 
 /// Format a weight for case ids and labels without a trailing `.0`.
@@ -402,10 +425,10 @@ impl Checker<'_> {
         }
     }
     fn ident(&self, key: &str, v: &str) -> Result<(), StudyError> {
-        if valid_ident(v) {
+        if ident_ok(v) {
             Ok(())
         } else {
-            Err(self.err(key, format!("{v:?}"), "must be 1-64 characters from [a-z0-9_-]"))
+            Err(self.err(key, format!("{v:?}"), format!("must be {IDENT_RULE}")))
         }
     }
     fn text(&self, key: &str, v: &str) -> Result<(), StudyError> {
@@ -436,7 +459,6 @@ const MAX_POINTS_PER_CASE: i64 = 2_000_000;
 /// Most cases of one sweep (methods × weights × points per cell × elements), checked before
 /// the case list is built.
 const MAX_CASES_PER_SWEEP: usize = 10_000;
-const MAX_POINTS_PER_CELL: i64 = 64;
 
 impl StudySpec {
     /// Parse and validate a study file's text; `file` names it in errors.
@@ -463,11 +485,11 @@ impl StudySpec {
         }
         c.ident("name", &self.name)?;
         c.text("summary", &self.summary)?;
-        if !(self.report_file.ends_with(".md") && valid_ident(self.report_file.trim_end_matches(".md"))) {
+        if !(self.report_file.ends_with(".md") && ident_ok(self.report_file.trim_end_matches(".md"))) {
             return Err(c.err(
                 "report_file",
                 format!("{:?}", self.report_file),
-                "must be a file name [a-z0-9_-]+.md",
+                format!("must be a file name <identifier>.md ({IDENT_RULE})"),
             ));
         }
         let col = &self.column;
@@ -647,7 +669,7 @@ impl StudySpec {
                 &format!("{}[{j}]", k("points_per_cell")),
                 n,
                 1,
-                MAX_POINTS_PER_CELL,
+                max_points_per_axis(1),
             )?;
         }
         let max_ppc = ppc.iter().copied().max().unwrap_or(1);

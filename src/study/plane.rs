@@ -383,13 +383,8 @@ pub fn status_word(s: CaseStatus) -> &'static str {
     }
 }
 
-/// A study, output or figure name: 1-64 characters from [a-z0-9_.-].
-pub fn ident_ok(s: &str) -> bool {
-    !s.is_empty()
-        && s.len() <= 64
-        && s.bytes()
-            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || matches!(b, b'-' | b'_' | b'.'))
-}
+/// The identifier rule of every study file ([`super::ident_ok`]).
+pub use super::ident_ok;
 
 /// Checks the keys every plane-strain study file starts with.
 pub fn check_header(
@@ -421,7 +416,7 @@ pub fn check_header(
             file,
             "name",
             name,
-            "must be 1-64 characters from [a-z0-9_.-]",
+            format!("must be {}", super::IDENT_RULE),
         ));
     }
     if !(report_file.ends_with(".md") && ident_ok(report_file.trim_end_matches(".md"))) {
@@ -429,7 +424,7 @@ pub fn check_header(
             file,
             "report_file",
             report_file,
-            "must be a file name [a-z0-9_.-]+.md",
+            format!("must be a file name <identifier>.md ({})", super::IDENT_RULE),
         ));
     }
     Ok(())
