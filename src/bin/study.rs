@@ -10,7 +10,7 @@ use igimp::study::runner::{
     read_results, run_study_in, study_dir, write_outputs, CaseRecord, CaseStatus, RunOptions,
 };
 use igimp::study::vtk_output::VtkOptions;
-use igimp::study::{plane, registry, study_files, StudyError, StudySpec, Tier};
+use igimp::study::{plane, registry, study_files, Distribution, StudyError, StudySpec, Tier};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -57,6 +57,29 @@ struct Cli {
     /// the compaction writes its initial and final states only).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     vtk_every: Option<u32>,
+    /// Solve only shard K of N (0 <= K < N): the cases whose index in the deterministic case
+    /// order is K mod N, stored in `<out>/<name>/cases/`; nothing is rendered. Run every
+    /// shard (e.g. as a Slurm job array, examples/slurm/), then `--merge`.
+    #[arg(long, value_name = "K/N", value_parser = parse_shard, conflicts_with_all = ["merge", "render_only"])]
+    shard: Option<Distribution>,
+    /// Read every case from the case store the shards wrote (an error lists any missing one),
+    /// then fit, check, write results.json and render as an unsharded run would.
+    #[arg(long, conflicts_with = "render_only")]
+    merge: bool,
+}
+
+fn parse_shard(text: &str) -> Result<Distribution, String> {
+    Distribution::parse_shard(text)
+}
+
+impl Cli {
+    fn distribution(&self) -> Distribution {
+        match (self.shard, self.merge) {
+            (Some(d), _) => d,
+            (None, true) => Distribution::Merge,
+            (None, false) => Distribution::Whole,
+        }
+    }
 }
 
 /// `studies/` in the working directory, else the one in the source tree.
@@ -149,11 +172,16 @@ fn run_plane(file: &Path, cli: &Cli) -> Result<Option<bool>, StudyError> {
         vtk: (cli.vtk || cli.vtk_every.is_some()).then(|| VtkOptions {
             every: cli.vtk_every.map_or(0, |n| n as usize),
         }),
+        distribution: cli.distribution(),
         on_start: &on_start,
         on_done: &on_done,
     };
     let ran = registry::run_file(file, &text, &problem, tier, &cli.out, cli.render_only, options);
     bar.finish_and_clear();
+    if let Err(e @ StudyError::ShardDone { .. }) = &ran {
+        eprintln!("{problem}: {e}");
+        return Ok(Some(true));
+    }
     let (dir, summary, files) = ran?;
     if let Some(r) = summary.as_ref().filter(|_| cli.resume) {
         eprintln!(
@@ -207,9 +235,14 @@ fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
             vtk: (cli.vtk || cli.vtk_every.is_some()).then(|| VtkOptions {
                 every: cli.vtk_every.map_or(0, |n| n as usize),
             }),
+            distribution: cli.distribution(),
         };
         let run = run_study_in(&spec, &file_name, tier, &options, &on_done);
         bar.finish_and_clear();
+        if let Err(e @ StudyError::ShardDone { .. }) = &run {
+            eprintln!("{}: {e}", spec.name);
+            return Ok(true);
+        }
         let run = run?;
         if cli.resume {
             eprintln!(

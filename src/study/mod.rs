@@ -45,6 +45,67 @@ pub enum StudyError {
     },
     #[error("{path}: {message}")]
     Io { path: String, message: String },
+    /// `--shard`: this shard's cases are solved and stored; nothing else is written.
+    #[error("shard {k}/{n}: solved and stored {solved} of {total} cases in {dir}; run with --merge once every shard is done")]
+    ShardDone {
+        k: usize,
+        n: usize,
+        solved: usize,
+        total: usize,
+        dir: String,
+    },
+    /// `--merge` with cases no shard has stored (for these inputs).
+    #[error("{dir}: --merge: {} of {total} cases not stored by any shard (or stored for other inputs): {}", missing.len(), missing.join(", "))]
+    MissingCases {
+        dir: String,
+        total: usize,
+        missing: Vec<String>,
+    },
+}
+
+/// How a run shares its cases between processes (`study --shard K/N`, `study --merge`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Distribution {
+    /// Solve (or resume) every case and write the results.
+    #[default]
+    Whole,
+    /// Solve only the cases whose index in the deterministic case order is ≡ k (mod n), store
+    /// them in the case store and write nothing else ([`StudyError::ShardDone`]).
+    Shard { k: usize, n: usize },
+    /// Solve nothing: read every case from the store (the shards'), then fit, check and write
+    /// the results as an unsharded run would ([`StudyError::MissingCases`] if one is absent).
+    Merge,
+}
+
+impl Distribution {
+    /// Does this process solve case `index`?
+    pub fn owns(&self, index: usize) -> bool {
+        match *self {
+            Distribution::Shard { k, n } => index % n == k,
+            _ => true,
+        }
+    }
+
+    /// Parse `K/N` with 0 ≤ K < N.
+    pub fn parse_shard(text: &str) -> Result<Self, String> {
+        let (k, n) = text
+            .split_once('/')
+            .ok_or_else(|| format!("{text:?}: expected K/N, e.g. 0/4"))?;
+        let k: usize = k
+            .trim()
+            .parse()
+            .map_err(|_| format!("{text:?}: K must be an integer"))?;
+        let n: usize = n
+            .trim()
+            .parse()
+            .map_err(|_| format!("{text:?}: N must be an integer"))?;
+        if n == 0 || k >= n {
+            return Err(format!(
+                "{text:?}: need 0 <= K < N (K is the 0-based shard index)"
+            ));
+        }
+        Ok(Distribution::Shard { k, n })
+    }
 }
 
 impl StudyError {

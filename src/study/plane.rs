@@ -227,6 +227,8 @@ pub struct PlaneRunOptions<'a> {
     pub resume: bool,
     /// Write ParaView files of the material point domains of each iGIMP case.
     pub vtk: Option<super::vtk_output::VtkOptions>,
+    /// `--shard K/N` or `--merge` (needs `study_dir`).
+    pub distribution: super::Distribution,
     /// Called once with the number of cases, then with each case's id and status when done.
     pub on_start: &'a (dyn Fn(usize) + Sync),
     pub on_done: &'a (dyn Fn(&str, CaseStatus) + Sync),
@@ -238,6 +240,7 @@ impl Default for PlaneRunOptions<'_> {
             study_dir: None,
             resume: false,
             vtk: None,
+            distribution: super::Distribution::Whole,
             on_start: &|_| {},
             on_done: &|_, _| {},
         }
@@ -299,14 +302,38 @@ pub fn run_cases_stored<C: Sync, R: Send + Serialize + DeserializeOwned>(
     vtk: impl Fn(&Path, &C, &R) -> Result<(), StudyError> + Sync,
     options: &PlaneRunOptions<'_>,
 ) -> Result<(Vec<(R, f64)>, usize), StudyError> {
-    (options.on_start)(cases.len());
+    use super::Distribution;
     let store = match &options.study_dir {
         Some(dir) => Some(super::store::CaseStore::open(&dir.join("cases"))?),
         None => None,
     };
+    let distribution = options.distribution;
+    if let (Distribution::Merge, Some(store), Some(dir)) = (distribution, &store, &options.study_dir) {
+        let missing: Vec<String> = cases
+            .iter()
+            .map(&key)
+            .filter(|(id, hash, _)| store.load::<StoredCase<R>>(id, hash).is_none())
+            .map(|(id, _, _)| id)
+            .collect();
+        if !missing.is_empty() {
+            return Err(StudyError::MissingCases {
+                dir: dir.join("cases").display().to_string(),
+                total: cases.len(),
+                missing,
+            });
+        }
+    }
+    let resume = options.resume || distribution == Distribution::Merge;
+    let own: Vec<&C> = cases
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| distribution.owns(*i))
+        .map(|(_, c)| c)
+        .collect();
+    (options.on_start)(own.len());
     let resumed = std::sync::atomic::AtomicUsize::new(0);
     let outputs = run_cases(
-        &cases.iter().collect::<Vec<_>>(),
+        &own,
         |c| cost(c),
         |c| {
             let (id, hash, has_vtk) = key(c);
@@ -319,7 +346,7 @@ pub fn run_cases_stored<C: Sync, R: Send + Serialize + DeserializeOwned>(
                 Some(_) if has_vtk => super::vtk_output::pvd_path(dir, &id)?.exists(),
                 _ => true,
             };
-            if options.resume && vtk_done {
+            if resume && vtk_done {
                 if let Some(s) = store.load::<StoredCase<R>>(&id, &hash) {
                     resumed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                     (options.on_done)(&id, status(&s.output));
@@ -342,6 +369,15 @@ pub fn run_cases_stored<C: Sync, R: Send + Serialize + DeserializeOwned>(
     for (r, secs) in outputs {
         let (r, stored_secs) = r?;
         out.push((r, stored_secs.unwrap_or(secs)));
+    }
+    if let (Distribution::Shard { k, n }, Some(dir)) = (distribution, &options.study_dir) {
+        return Err(StudyError::ShardDone {
+            k,
+            n,
+            solved: out.len(),
+            total: cases.len(),
+            dir: dir.join("cases").display().to_string(),
+        });
     }
     Ok((out, resumed.into_inner()))
 }

@@ -286,6 +286,8 @@ pub struct RunOptions {
     pub resume: bool,
     /// Write ParaView files of every case.
     pub vtk: Option<VtkOptions>,
+    /// `--shard K/N` or `--merge`.
+    pub distribution: super::Distribution,
 }
 
 /// What the case store keeps of a finished column case.
@@ -326,15 +328,36 @@ pub fn run_study_in(
     options: &RunOptions,
     on_case_done: &(dyn Fn(&CaseRecord) + Sync),
 ) -> Result<StudyRun, StudyError> {
+    use super::Distribution;
     let dir = study_dir(&options.out, &spec.name);
     let store = CaseStore::open(&dir.join("cases"))?;
+    let resume = options.resume || options.distribution == Distribution::Merge;
+    if options.distribution == Distribution::Merge {
+        let missing: Vec<String> = spec
+            .cases(tier)
+            .iter()
+            .filter(|c| {
+                store
+                    .load::<StoredCase>(&c.id, &case_definition_hash(c))
+                    .is_none()
+            })
+            .map(|c| c.id.clone())
+            .collect();
+        if !missing.is_empty() {
+            return Err(StudyError::MissingCases {
+                dir: dir.join("cases").display().to_string(),
+                total: spec.cases(tier).len(),
+                missing,
+            });
+        }
+    }
     let solve = |case: &Case| -> Result<((CaseRecord, Vec<PointRecord>), bool), StudyError> {
         let hash = case_definition_hash(case);
         let vtk_done = match options.vtk {
             Some(_) => pvd_path(&dir, &case.id)?.exists(),
             None => true,
         };
-        if options.resume && vtk_done {
+        if resume && vtk_done {
             if let Some(s) = store.load::<StoredCase>(&case.id, &hash) {
                 return Ok(((s.record, s.points), true));
             }
@@ -352,6 +375,24 @@ pub fn run_study_in(
         store.save(&case.id, &hash, &stored)?;
         Ok(((stored.record, stored.points), false))
     };
+    if let Distribution::Shard { k, n } = options.distribution {
+        let cases = spec.cases(tier);
+        let own: Vec<&Case> = cases
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| options.distribution.owns(*i))
+            .map(|(_, c)| c)
+            .collect();
+        own.par_iter()
+            .try_for_each(|c| solve(c).map(|((rec, _), _)| on_case_done(&rec)))?;
+        return Err(StudyError::ShardDone {
+            k,
+            n,
+            solved: own.len(),
+            total: cases.len(),
+            dir: dir.join("cases").display().to_string(),
+        });
+    }
     run_cases(spec, study_file, tier, &solve, on_case_done)
 }
 

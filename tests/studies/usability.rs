@@ -465,3 +465,68 @@ print(json.dumps({"type": m.cells[0].type, "n": len(m.cells[0].data),
         assert!((v - r).abs() <= 1e-12 * r.abs().max(1.0), "point {p}: {v} vs {r}");
     }
 }
+
+/// `--shard K/N` then `--merge` gives the results.json of an unsharded run (timing aside) for
+/// a column and a plane-strain study; shards write no results.json; `--merge` with a shard
+/// missing fails naming the cases no shard stored.
+#[test]
+fn sharded_runs_merge_to_the_unsharded_results() {
+    use igimp::study::compaction;
+    let tmp = tempfile::tempdir().unwrap();
+    write_study(tmp.path(), "tiny", TINY);
+    let studies = tmp.path().join("studies");
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies");
+    let n = 3;
+    for k in 0..n {
+        let shard = format!("{k}/{n}");
+        let stderr = run_with(
+            &studies,
+            "tiny",
+            &tmp.path().join("sharded"),
+            1,
+            &["--shard", &shard],
+        );
+        assert!(stderr.contains(&format!("shard {k}/{n}")), "{stderr}");
+        if k == 0 {
+            // Merging before every shard has run names what is missing.
+            let out = study_bin()
+                .args(["tiny", "--merge", "--studies-dir"])
+                .arg(&studies)
+                .arg("--out")
+                .arg(tmp.path().join("sharded"))
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                !out.status.success() && err.contains("not stored by any shard"),
+                "{err}"
+            );
+        }
+        run_with(
+            &repo,
+            "compaction",
+            &tmp.path().join("sharded"),
+            1,
+            &["--quick", "--shard", &shard],
+        );
+    }
+    assert!(!tmp.path().join("sharded/tiny/results.json").exists());
+    assert!(!tmp.path().join("sharded/compaction/results.json").exists());
+    run_with(&studies, "tiny", &tmp.path().join("sharded"), 2, &["--merge"]);
+    run_with(
+        &repo,
+        "compaction",
+        &tmp.path().join("sharded"),
+        2,
+        &["--quick", "--merge"],
+    );
+    run(tmp.path(), "tiny", "whole", 2, &[]);
+    run_with(&repo, "compaction", &tmp.path().join("whole"), 2, &["--quick"]);
+    assert_eq!(
+        results(tmp.path(), "sharded", "tiny").without_timing(),
+        results(tmp.path(), "whole", "tiny").without_timing()
+    );
+    let a = compaction::read_results(&tmp.path().join("sharded/compaction")).unwrap();
+    let b = compaction::read_results(&tmp.path().join("whole/compaction")).unwrap();
+    assert_eq!(a.without_timing(), b.without_timing());
+}

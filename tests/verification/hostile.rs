@@ -130,7 +130,9 @@ fn check_error(e: &StudyError, expected_key: Option<&str>) -> Result<(), TestCas
                 );
             }
         }
-        StudyError::Io { .. } => prop_assert!(false, "unexpected I/O error {msg}"),
+        StudyError::Io { .. } | StudyError::ShardDone { .. } | StudyError::MissingCases { .. } => {
+            prop_assert!(false, "unexpected error from parsing {msg}")
+        }
     }
     Ok(())
 }

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Run a study on a Slurm cluster: N array tasks (one shard each), then a merge job that
+# depends on all of them.
+#
+#   bash examples/slurm/submit.sh compaction 8           # full tier, 8 shards
+#   TIER=quick bash examples/slurm/submit.sh column 4    # quick tier
+#   WAIT=1 ...                                           # block until the merge is done
+#
+# Run from the repository root; the release binary is built first (once, on the login node).
+set -euo pipefail
+STUDY="${1:?usage: submit.sh <study> <shards>}"
+N="${2:?usage: submit.sh <study> <shards>}"
+here="$(cd "$(dirname "$0")" && pwd)"
+cargo build --release --locked --bin study
+export STUDY TIER="${TIER:-}" OUT="${OUT:-reports}" STUDY_BIN="${STUDY_BIN:-$PWD/target/release/study}"
+array=$(sbatch --parsable --export=ALL --array="0-$((N - 1))" "$here/shard.sbatch")
+merge=$(sbatch --parsable --export=ALL --dependency="afterok:${array%%;*}" \
+    ${WAIT:+--wait} "$here/merge.sbatch")
+echo "submitted shards $array (array of $N) and merge $merge; results in $OUT/$STUDY/"
