@@ -44,7 +44,8 @@ for _ in $(seq 60); do
 done
 sinfo
 out="$(mktemp -d)"
-OUT="$out/sharded" TIER=quick WAIT=1 bash examples/slurm/submit.sh column 3
+[ -x target/release/study ] || cargo build --release --locked --bin study
+OUT="$out/sharded" TIER=quick WAIT=1 SKIP_BUILD=1 bash examples/slurm/submit.sh column 3
 target/release/study column --quick --out "$out/whole" >/dev/null 2>&1
 python3 - "$out" <<'PY'
 import json, sys

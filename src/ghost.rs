@@ -40,8 +40,8 @@
 //! active cells, which also controls the odd–even (1D) and hourglass (2D) modes of one point
 //! per cell.
 
-use crate::assembly::DofMap;
 use crate::basis::Basis;
+use crate::dofs::DofMap;
 use crate::error::InputError;
 use crate::grid::Grid;
 use crate::linear::SparseSystem;

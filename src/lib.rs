@@ -39,6 +39,7 @@ pub mod assembly;
 pub mod atomic_file;
 pub mod basis;
 pub mod constitutive;
+pub mod dofs;
 pub mod error;
 pub mod fem;
 pub mod ghost;

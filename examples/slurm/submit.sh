@@ -11,7 +11,8 @@ set -euo pipefail
 STUDY="${1:?usage: submit.sh <study> <shards>}"
 N="${2:?usage: submit.sh <study> <shards>}"
 here="$(cd "$(dirname "$0")" && pwd)"
-cargo build --release --locked --bin study
+# SKIP_BUILD=1 uses an existing target/release/study (CI: the one `cargo test --release` built).
+[ -n "${SKIP_BUILD:-}" ] || cargo build --release --locked --bin study
 export STUDY TIER="${TIER:-}" OUT="${OUT:-reports}" STUDY_BIN="${STUDY_BIN:-$PWD/target/release/study}"
 array=$(sbatch --parsable --export=ALL --array="0-$((N - 1))" "$here/shard.sbatch")
 merge=$(sbatch --parsable --export=ALL --dependency="afterok:${array%%;*}" \

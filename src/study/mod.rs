@@ -14,6 +14,7 @@ pub mod compaction;
 pub mod plane;
 pub mod rates;
 pub mod registry;
+pub mod results;
 pub mod runner;
 pub mod store;
 pub mod vtk_output;

@@ -5,53 +5,11 @@
 //! one series (method, weight, points per cell). Pairwise log2 rates per refinement are
 //! computed by [`pairwise_rates`] for the tables.
 
-use super::runner::{CaseRecord, CaseStatus};
+pub use super::results::{CaseIndex, ComparisonRecord, ExpectedBand, RateRecord};
+use super::results::{CaseRecord, CaseStatus};
 use super::{uses_material_points, Measure, StudySpec, Tier};
 use crate::norms::fitted_rate;
 use crate::problems::column::Method;
-use serde::{Deserialize, Serialize};
-
-/// The band a fitted rate must fall in, with its source.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ExpectedBand {
-    pub rate: f64,
-    pub tolerance: f64,
-    pub source: String,
-}
-
-/// Fitted rate of one series.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct RateRecord {
-    pub sweep: String,
-    pub method: Method,
-    pub load: f64,
-    pub points_per_cell: Option<usize>,
-    pub measure: Measure,
-    /// Slope of log(error) against log(h); `None` with fewer than two converged cases.
-    pub slope: Option<f64>,
-    /// Element counts the fit used.
-    pub elements_used: Vec<usize>,
-    pub expected: Option<ExpectedBand>,
-    /// `None` when nothing is expected, or the series was not run in this tier.
-    pub pass: Option<bool>,
-}
-
-/// Outcome of an `[[compare]]` check.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ComparisonRecord {
-    pub sweep: String,
-    pub load: f64,
-    pub measure: Measure,
-    pub lower: Method,
-    pub higher: Method,
-    /// Element counts where both methods converged.
-    pub elements_checked: Vec<usize>,
-    /// error(lower) / error(higher) at each checked element count.
-    pub ratios: Vec<f64>,
-    /// `None` when no element count could be checked.
-    pub pass: Option<bool>,
-    pub source: String,
-}
 
 /// The error of a case under a measure (converged cases only).
 pub fn case_error(case: &CaseRecord, measure: Measure) -> Option<f64> {
@@ -243,20 +201,4 @@ pub fn compute_comparisons(
             }
         })
         .collect()
-}
-
-/// Which case ids belong to which sweep (a case may belong to several).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct CaseIndex {
-    /// (sweep id, case ids in run order).
-    pub sweeps: Vec<(String, Vec<String>)>,
-}
-
-impl CaseIndex {
-    pub fn of_sweep(&self, id: &str) -> &[String] {
-        self.sweeps
-            .iter()
-            .find(|(s, _)| s == id)
-            .map_or(&[], |(_, v)| v.as_slice())
-    }
 }

@@ -9,11 +9,14 @@
 //! Wall-clock times are the only fields that differ between two runs (`wall_seconds` of each
 //! case and the `timing` block).
 
-use super::rates::{compute_comparisons, compute_rates, CaseIndex, ComparisonRecord, RateRecord};
+use super::rates::{compute_comparisons, compute_rates};
+pub use super::results::{
+    CaseRecord, CaseStatus, FailureRecord, Software, StepRecord, StudyResults, Timing, POINTS_HEADER,
+    POINTS_HEADER_PLASTIC,
+};
 use super::store::{case_hash, write_file, CaseStore};
 use super::vtk_output::{pvd_path, ColumnVtkWriter, VtkOptions};
 use super::{Case, StudyError, StudySpec, Tier};
-use crate::newton::NewtonSettings;
 use crate::problems::column::{solve_column_observed, ColumnObserver, ColumnSpec, Method, PointRecord};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -21,144 +24,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
-
-/// Header of the per-case point files.
-pub const POINTS_HEADER: &str = "z0,z,volume0,sigma_zz,f_zz";
-/// Header of the per-case point files of plastic studies (adds the lateral stress).
-pub const POINTS_HEADER_PLASTIC: &str = "z0,z,volume0,sigma_zz,f_zz,sigma_xx";
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CaseStatus {
-    /// Every load step converged.
-    Converged,
-    /// A load step failed (see `failure`); errors are not reported.
-    Failed,
-    /// The solver refused the input (see `failure.reason`); nothing was solved.
-    Rejected,
-}
-
-/// Newton residual history of one converged load step.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StepRecord {
-    pub step: usize,
-    pub load_factor: f64,
-    /// Normalised out-of-balance force before the first and after each Newton update.
-    pub residuals: Vec<f64>,
-}
-
-/// Why a case did not converge.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct FailureRecord {
-    /// Load step that failed (from 1); 0 when the input was rejected.
-    pub step: usize,
-    pub reason: String,
-    /// Residual history of the failing step.
-    pub residuals: Vec<f64>,
-}
-
-/// Result of one case.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CaseRecord {
-    pub id: String,
-    pub method: Method,
-    /// Total weight W.
-    pub load: f64,
-    pub elements: usize,
-    /// `None` (null) for FEM.
-    pub points_per_cell: Option<usize>,
-    pub load_steps: usize,
-    pub newton: NewtonSettings,
-    pub status: CaseStatus,
-    pub failure: Option<FailureRecord>,
-    /// Eq (46), converged cases only.
-    pub stress_error: Option<f64>,
-    /// Eq (47) against the exact analytical base F, converged cases only.
-    pub f_error: Option<f64>,
-    /// Eq (46) on σ_xx (plastic studies only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sigma_xx_error: Option<f64>,
-    /// Yield height seen by the points (plastic studies only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub yield_height: Option<f64>,
-    /// |yield_height − analytical| / L0 (plastic studies only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub yield_height_error: Option<f64>,
-    pub top_displacement: Option<f64>,
-    pub base_f: Option<f64>,
-    /// Number of material or Gauss points (rows of the point file).
-    pub points: usize,
-    /// Newton iterations summed over the converged steps.
-    pub newton_iterations: usize,
-    pub steps: Vec<StepRecord>,
-    pub wall_seconds: f64,
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Software {
-    pub name: String,
-    pub version: String,
-}
-
-/// Wall-clock data: the only part of `results.json` that changes from run to run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Timing {
-    pub wall_seconds: f64,
-    pub threads: usize,
-}
-
-/// Everything the renderers need: `results.json`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StudyResults {
-    pub software: Software,
-    /// File name of the study file the inputs came from.
-    pub study_file: String,
-    pub tier: Tier,
-    /// The study inputs as parsed.
-    pub study: StudySpec,
-    /// Case ids of each sweep.
-    pub sweep_cases: CaseIndex,
-    pub cases: Vec<CaseRecord>,
-    pub rates: Vec<RateRecord>,
-    pub comparisons: Vec<ComparisonRecord>,
-    pub timing: Timing,
-}
-
-impl StudyResults {
-    pub fn case(&self, id: &str) -> Option<&CaseRecord> {
-        self.cases.iter().find(|c| c.id == id)
-    }
-
-    /// Copy with every wall-clock field zeroed, for comparing two runs.
-    pub fn without_timing(&self) -> Self {
-        let mut r = self.clone();
-        r.timing = Timing {
-            wall_seconds: 0.0,
-            threads: 0,
-        };
-        r.cases.iter_mut().for_each(|c| c.wall_seconds = 0.0);
-        r
-    }
-
-    /// Rates and comparisons with an expectation: (passed, failed, not evaluated).
-    pub fn check_counts(&self) -> (usize, usize, usize) {
-        let passes = self
-            .rates
-            .iter()
-            .filter(|r| r.expected.is_some())
-            .map(|r| r.pass)
-            .chain(self.comparisons.iter().map(|c| c.pass));
-        let mut n = (0, 0, 0);
-        for p in passes {
-            match p {
-                Some(true) => n.0 += 1,
-                Some(false) => n.1 += 1,
-                None => n.2 += 1,
-            }
-        }
-        n
-    }
-}
 
 /// A solved study: the results and the final point values of each case (same order).
 #[derive(Debug, Clone)]
