@@ -16,7 +16,7 @@
 //! examples with their analytical solutions; [`norms`] the error measures (eqs 46–47).
 //!
 //! Verification studies are data (`studies/*.toml`): [`study`] parses them and runs the
-//! cases (compute → `results.json`), [`report`] and [`plot`] render tables and SVG figures
+//! cases (compute → `results.json`), [`render`] and [`plot`] render tables and SVG figures
 //! from that file alone. The `study` binary is the front door:
 //! `cargo run --release --bin study -- column`.
 //!
@@ -54,7 +54,7 @@ pub mod plot;
 pub mod plot2d;
 pub mod problems;
 pub mod quadrature;
-pub mod report;
+pub mod render;
 pub mod study;
 pub mod tensor;
 pub mod vtk;

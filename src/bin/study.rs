@@ -5,7 +5,7 @@
 //! SVG figures and `reports/index.md` from those files.
 
 use clap::{CommandFactory, FromArgMatches, Parser};
-use igimp::report;
+use igimp::render::column as report;
 use igimp::study::runner::{
     read_results, run_study_in, study_dir, write_outputs, CaseRecord, CaseStatus, RunOptions,
 };

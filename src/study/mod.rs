@@ -4,7 +4,7 @@
 //!
 //! Pipeline (compute → JSON → render): [`runner::run_study`] solves every case (rayon, results
 //! in a fixed order) and [`runner::write_outputs`] writes `results.json` and the per-case point
-//! CSVs; [`crate::report`] and [`crate::plot`] read only those files.
+//! CSVs; [`crate::render`] and [`crate::plot`] read only those files.
 //!
 //! Counts in the file are parsed as signed integers so that a negative value is reported by
 //! [`StudySpec::validate`] with its key and allowed range instead of as a type error.

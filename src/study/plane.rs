@@ -3,7 +3,7 @@
 //! imports neither.
 //!
 //! Their study files carry `problem = "compaction"` / `"cantilever"`; the `study` binary and
-//! [`crate::report::render_index`] dispatch on that key ([`problem_of_study`],
+//! [`crate::render::column::render_index`] dispatch on that key ([`problem_of_study`],
 //! [`problem_of_results`]) and otherwise use the column study's conventions: compute →
 //! `results.json` → render, rayon across cases with the records in study order, failed cases
 //! recorded with their step, reason and residuals, `--quick`, `--render-only`, `--check`, the

@@ -133,8 +133,8 @@ pub fn run_file(
 /// Render the tables and figures of a plane-strain study folder from its results.
 pub fn render_dir(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
     match problem_of_results(dir).as_deref() {
-        Some("compaction") => compaction::render(dir),
-        Some("cantilever") => cantilever::render(dir),
+        Some("compaction") => crate::render::compaction::render(dir),
+        Some("cantilever") => crate::render::cantilever::render(dir),
         _ => Err(StudyError::io(
             &dir.join("results.json"),
             "not a plane-strain study result",
@@ -145,8 +145,8 @@ pub fn render_dir(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
 /// The index entry of a plane-strain study folder; `None` for other studies.
 pub fn index_entry(dir: &Path) -> Result<Option<IndexEntry>, StudyError> {
     match problem_of_results(dir).as_deref() {
-        Some("compaction") => compaction::index_entry(dir).map(Some),
-        Some("cantilever") => cantilever::index_entry(dir).map(Some),
+        Some("compaction") => crate::render::compaction::index_entry(dir).map(Some),
+        Some("cantilever") => crate::render::cantilever::index_entry(dir).map(Some),
         _ => Ok(None),
     }
 }

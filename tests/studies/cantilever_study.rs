@@ -5,9 +5,8 @@
 //!
 //! Everything is written to temporary folders, never to the repository's `reports/`.
 
-use igimp::study::cantilever::{
-    read_results, render, run_study, write_outputs, CantileverRun, CantileverStudy,
-};
+use igimp::render::cantilever::render;
+use igimp::study::cantilever::{read_results, run_study, write_outputs, CantileverRun, CantileverStudy};
 use igimp::study::plane::PlaneStudy;
 use igimp::study::runner::CaseStatus;
 use igimp::study::Tier;

@@ -4,9 +4,8 @@
 //!
 //! Everything is written to temporary folders, never to the repository's `reports/`.
 
-use igimp::study::compaction::{
-    read_results, render, run_study, write_outputs, CompactionRun, CompactionStudy,
-};
+use igimp::render::compaction::render;
+use igimp::study::compaction::{read_results, run_study, write_outputs, CompactionRun, CompactionStudy};
 use igimp::study::plane::PlaneStudy;
 use igimp::study::runner::CaseStatus;
 use igimp::study::Tier;

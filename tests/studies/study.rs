@@ -5,7 +5,7 @@
 //! Everything is written to temporary folders, never to the repository's `reports/`.
 
 use igimp::problems::column::Method;
-use igimp::report;
+use igimp::render::column as report;
 use igimp::study::rates::RateRecord;
 use igimp::study::runner::{read_results, run_study, write_outputs, CaseStatus, StudyRun};
 use igimp::study::{Measure, StudyError, StudySpec, Tier};

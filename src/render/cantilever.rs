@@ -1,0 +1,300 @@
+//! Rendering of the cantilever study (§5.3): the report and Figures 19–21 from `results.json`
+//! and `domains.json` only.
+
+use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, PointMarks, XyAxes, XySeries};
+use crate::problems::cantilever::DomainSnapshot;
+use crate::study::cantilever::*;
+use crate::study::plane::{self, IndexEntry};
+use crate::study::runner::CaseStatus;
+use crate::study::StudyError;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+fn f5(x: Option<f64>) -> String {
+    x.map_or("—".into(), |v| format!("{v:.5}"))
+}
+
+fn pct(x: Option<f64>) -> String {
+    x.map_or("—".into(), |v| format!("{:+.2} %", 100.0 * v))
+}
+
+fn case_label(study: &CantileverStudy, r: &CantileverRecord) -> String {
+    study
+        .cases
+        .iter()
+        .find(|c| c.id == r.id)
+        .map_or_else(|| r.id.clone(), |c| c.title.clone())
+}
+
+/// The main report.
+pub fn report_markdown(results: &CantileverResults) -> String {
+    let study = &results.study;
+    let (pass, fail, none) = plane::check_counts(&results.checks);
+    let mut s = format!(
+        "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated.\n\n",
+        study.name,
+        study.summary,
+        results.provenance.line()
+    );
+    s.push_str("## End displacement at the full load\n\nMean of the two loaded points (iGIMP); Δ = (continuum − elastica)/|elastica| against the plane-strain elastica of the same beam.\n\n");
+    s.push_str("| case | method | domain / volume update | status | steps | u/L | v/L | elastica u/L | elastica v/L | Δu | Δv |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    for r in &results.cases {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {}/{} | {} | {} | {} | {} | {} | {} |",
+            r.id,
+            r.method.label(),
+            match (r.domain_update, r.volume_update) {
+                (Some(d), Some(v)) => format!("{d:?} / {v:?}"),
+                _ => "—".into(),
+            },
+            plane::status_word(r.status),
+            r.end.len(),
+            r.load_steps,
+            f5(r.u_over_l),
+            f5(r.v_over_l),
+            f5(r.elastica.map(|e| e.u_over_l)),
+            f5(r.elastica.map(|e| e.v_over_l)),
+            pct(r.difference_u),
+            pct(r.difference_v)
+        );
+    }
+    s.push('\n');
+    for p in &results.elastica {
+        let _ = writeln!(
+            s,
+            "Elastica, plane {}: EI = {:.6e} N·m, α = PL²/EI = {:.4} at the full load.\n",
+            if p.plane_strain { "strain" } else { "stress" },
+            p.bending_stiffness,
+            p.points.last().map_or(f64::NAN, |e| e.alpha)
+        );
+    }
+    if !results.depth_study.is_empty() {
+        s.push_str("## Depth study\n\nThe same PL²/EI (P ∝ depth³) and a fixed number of elements through the depth (h ∝ depth); the elastica is the same for every row.\n\n| case | elements through depth | depth | P | h | u/L | v/L | Δu | Δv |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+        for r in &results.depth_study {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                r.case,
+                r.elements_through_depth,
+                r.depth,
+                r.load,
+                r.element_size,
+                f5(r.u_over_l),
+                f5(r.v_over_l),
+                pct(r.difference_u),
+                pct(r.difference_v)
+            );
+        }
+        s.push('\n');
+    }
+    s.push_str(&plane::checks_markdown(&results.checks));
+    // Load path every 5 steps (Figure 21's data).
+    let shown: Vec<&CantileverRecord> = results
+        .cases
+        .iter()
+        .filter(|r| !r.end.is_empty() && study.cases.iter().any(|c| c.id == r.id))
+        .collect();
+    if let Some(el) = results.elastica.first() {
+        s.push_str("## Load path (every 5th step)\n\n| step | P (kN) | elastica u/L | elastica v/L |");
+        for r in &shown {
+            let _ = write!(s, " {0} u/L | {0} v/L |", r.id);
+        }
+        s.push_str("\n|---:|---:|---:|---:|");
+        for _ in &shown {
+            s.push_str("---:|---:|");
+        }
+        s.push('\n');
+        for (i, e) in el.points.iter().enumerate().filter(|(i, _)| (i + 1) % 5 == 0) {
+            let _ = write!(
+                s,
+                "| {} | {:.1} | {:.5} | {:.5} |",
+                i + 1,
+                e.load / 1e3,
+                e.u_over_l,
+                e.v_over_l
+            );
+            for r in &shown {
+                let d = r.end.iter().find(|d| d.step == i + 1);
+                let _ = write!(
+                    s,
+                    " {} | {} |",
+                    f5(d.map(|d| d.u_over_l)),
+                    f5(d.map(|d| d.v_over_l))
+                );
+            }
+            s.push('\n');
+        }
+        s.push('\n');
+    }
+    s.push_str(&plane::failures_markdown(
+        results
+            .cases
+            .iter()
+            .map(|c| (c.id.as_str(), c.status, c.failure.as_ref())),
+    ));
+    if !study.figures.is_empty() {
+        s.push_str("## Figures\n\n");
+        for f in &study.figures {
+            let _ = writeln!(s, "### {}\n\n![{}]({}.svg)\n", f.title, f.id, f.id);
+        }
+    }
+    s
+}
+
+fn render_figure(
+    results: &CantileverResults,
+    snapshots: &BTreeMap<String, Vec<DomainSnapshot>>,
+    dir: &Path,
+    f: &CantileverFigure,
+) -> Result<Option<String>, StudyError> {
+    let path = dir.join(format!("{}.svg", f.id)).display().to_string();
+    let fail = |message| StudyError::Io {
+        path: path.clone(),
+        message,
+    };
+    match f.kind {
+        CantileverFigureKind::Domains => {
+            let id = &f.cases[0];
+            let (Some(rec), Some(snaps)) = (results.case(id), snapshots.get(id)) else {
+                return Ok(None);
+            };
+            let wanted: Vec<&DomainSnapshot> = match &f.steps {
+                Some(steps) => snaps
+                    .iter()
+                    .filter(|s| steps.contains(&(s.step as i64)))
+                    .collect(),
+                None => snaps.iter().collect(),
+            };
+            let domains = |s: &DomainSnapshot| -> Vec<Domain> {
+                s.domains
+                    .iter()
+                    .map(|d| Domain {
+                        centre: [d[0], d[1]],
+                        half: [d[2], d[3]],
+                    })
+                    .collect()
+            };
+            let last = wanted.len().saturating_sub(1);
+            let layers: Vec<DomainLayer> = wanted
+                .iter()
+                .enumerate()
+                .map(|(i, s)| DomainLayer {
+                    label: if s.step == 0 {
+                        "initial".into()
+                    } else {
+                        format!("load step {}", s.step)
+                    },
+                    domains: domains(s),
+                    values: None,
+                    colour: (s.step != 0).then_some(if wanted.len() <= 2 { 0 } else { i.min(last) }),
+                })
+                .collect();
+            let marks: Vec<PointMarks> = match (f.mark_loads, rec.loaded_points) {
+                (true, Some(lp)) => vec![PointMarks {
+                    label: "loaded points".into(),
+                    points: wanted
+                        .iter()
+                        .flat_map(|s| {
+                            lp.iter()
+                                .filter_map(move |&p| s.domains.get(p).map(|d| (d[0], d[1])))
+                        })
+                        .collect(),
+                }],
+                _ => vec![],
+            };
+            let title = match (&rec.failure, rec.status) {
+                (Some(fl), CaseStatus::Failed) => format!("{} (failed at step {})", f.title, fl.step),
+                _ => f.title.clone(),
+            };
+            domains_svg(&title, "", &layers, &marks).map(Some).map_err(fail)
+        }
+        CantileverFigureKind::EndDisplacement => {
+            let mut series = vec![];
+            for p in &results.elastica {
+                let plane = if p.plane_strain {
+                    "plane strain"
+                } else {
+                    "plane stress"
+                };
+                for (name, pick) in [("u/L", 0), ("v/L", 1)] {
+                    series.push(XySeries {
+                        label: format!("elastica ({plane}) {name}"),
+                        points: p
+                            .points
+                            .iter()
+                            .map(|e| (e.load / 1e3, if pick == 0 { e.u_over_l } else { e.v_over_l }))
+                            .collect(),
+                        line: true,
+                        markers: false,
+                    });
+                }
+            }
+            for id in &f.cases {
+                let Some(r) = results.case(id) else { continue };
+                if r.end.is_empty() {
+                    continue;
+                }
+                let label = case_label(&results.study, r);
+                for (name, pick) in [("u/L", 0), ("v/L", 1)] {
+                    series.push(XySeries {
+                        label: format!("{label} {name}"),
+                        points: r
+                            .end
+                            .iter()
+                            .map(|d| (d.load / 1e3, if pick == 0 { d.u_over_l } else { d.v_over_l }))
+                            .collect(),
+                        line: false,
+                        markers: true,
+                    });
+                }
+            }
+            let axes = XyAxes {
+                x_desc: "end load P (kN)".into(),
+                y_desc: "end displacement / L".into(),
+                log_x: false,
+                log_y: false,
+                y_lines: vec![],
+                legend: LegendCorner::UpperRight,
+            };
+            xy_svg(&f.title, &axes, &series).map(Some).map_err(fail)
+        }
+    }
+}
+
+/// Render the report and figures from `dir`'s `results.json` and `domains.json`.
+pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+    let results = read_results(dir)?;
+    let snapshots: BTreeMap<String, Vec<DomainSnapshot>> = plane::read_json(&dir.join("domains.json"))?;
+    let mut written = vec![];
+    plane::write_text(
+        &dir.join(&results.study.report_file),
+        &report_markdown(&results),
+        &mut written,
+    )?;
+    for f in &results.study.figures {
+        if let Some(svg) = render_figure(&results, &snapshots, dir, f)? {
+            plane::write_text(&dir.join(format!("{}.svg", f.id)), &svg, &mut written)?;
+        }
+    }
+    Ok(written)
+}
+
+pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
+    let r = read_results(dir)?;
+    let mut files = vec![("report".to_string(), r.study.report_file.clone())];
+    files.extend(
+        r.study
+            .figures
+            .iter()
+            .map(|f| (f.title.clone(), format!("{}.svg", f.id))),
+    );
+    Ok(IndexEntry {
+        name: r.study.name,
+        summary: r.study.summary,
+        tier: r.provenance.tier,
+        checks: r.checks,
+        files,
+    })
+}

@@ -1,0 +1,441 @@
+//! Rendering of the compaction study (§5.2): the report, Tables 2–3 and Figures 15–18 from
+//! `results.json` and `domains.json` only.
+
+use crate::newton::ResidualNorm;
+use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, XyAxes, XySeries};
+use crate::problems::compaction::DomainRecord;
+use crate::study::compaction::*;
+use crate::study::plane::{self, IndexEntry, PlaneMethod};
+use crate::study::runner::CaseStatus;
+use crate::study::StudyError;
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+fn e3(x: Option<f64>) -> String {
+    x.map_or("—".into(), |v| format!("{v:.3e}"))
+}
+
+fn ppc_label(p: usize) -> String {
+    format!("{p}×{p} points/cell")
+}
+
+/// Table 2 / Table 3: this code's residuals beside the paper's, per step and iteration.
+pub fn residual_table(results: &CompactionResults, p: &PaperResiduals) -> String {
+    let mut s = format!("# {}: {}\n\n{}\n\n", p.table, p.title, results.provenance.line());
+    let case = results.igimp_case(&p.sweep, p.element_size, p.points_per_cell as usize);
+    let measure = match results.study.newton.residual_norm {
+        ResidualNorm::External => "‖f_int − f_ext‖ / ‖f_ext‖ over the free dofs (`external`)",
+        ResidualNorm::Total => {
+            "‖f_int − f_ext‖ over the free dofs / ‖f_ext + f_reaction‖ over all dofs, exact reactions (`total`)"
+        }
+        ResidualNorm::Linearised => {
+            "‖f^ob‖ / ‖f_ext + f_rct‖ over all dofs, the reactions updated by their linearised increment as the paper's group computes them (`linearised`, reference/README.md item 18)"
+        }
+    };
+    let _ = writeln!(
+        s,
+        "Normalised out-of-balance force {measure} after each Newton iteration \
+         (iteration k is the residual after the k-th solve), case `{}`. \"code\" is this code, \
+         \"paper\" the printed value.\n",
+        case.map_or("(not run in this tier)", |c| c.id.as_str())
+    );
+    let Some(case) = case else { return s };
+    if case.status != CaseStatus::Converged {
+        let _ = writeln!(
+            s,
+            "The case did not converge: {}.\n",
+            case.failure
+                .as_ref()
+                .map_or(String::new(), |f| format!("step {}: {}", f.step, f.reason))
+        );
+    }
+    let rows = p.residuals.iter().map(Vec::len).max().unwrap_or(0).max(
+        p.steps
+            .iter()
+            .filter_map(|&st| case.steps.iter().find(|r| r.step == st as usize))
+            .map(|r| r.residuals.len().saturating_sub(1))
+            .max()
+            .unwrap_or(0),
+    );
+    let _ = write!(s, "| iteration |");
+    for st in &p.steps {
+        let _ = write!(s, " step {st} code | step {st} paper |");
+    }
+    let _ = write!(s, "\n|---:|");
+    for _ in &p.steps {
+        let _ = write!(s, "---:|---:|");
+    }
+    s.push('\n');
+    for k in 1..=rows {
+        let _ = write!(s, "| {k} |");
+        for (j, &st) in p.steps.iter().enumerate() {
+            let code = case
+                .steps
+                .iter()
+                .find(|r| r.step == st as usize)
+                .and_then(|r| r.residuals.get(k).copied());
+            let _ = write!(s, " {} | {} |", e3(code), e3(p.residuals[j].get(k - 1).copied()));
+        }
+        s.push('\n');
+    }
+    s.push('\n');
+    s
+}
+
+fn figure17_table(results: &CompactionResults) -> String {
+    let sweep_id = &results.study.reference.igimp_sweep;
+    let cases = results.sweep(sweep_id);
+    let mut hs: Vec<f64> = cases.iter().map(|c| c.h).collect();
+    hs.sort_by(|a, b| b.total_cmp(a));
+    hs.dedup();
+    let ppcs: BTreeSet<usize> = cases.iter().filter_map(|c| c.points_per_cell).collect();
+    let fems: BTreeSet<PlaneMethod> = cases.iter().map(|c| c.method).filter(|m| m.is_fem()).collect();
+    let reference = results.reference.as_ref();
+    let mut s = format!(
+        "## Figure 17: maximum horizontal displacement\n\nBottom-right material point's horizontal displacement plus half the growth of its domain \
+         (FEM: bottom-right node). Normalised by u_ref = {} ({}). Each cell: u, then u/u_ref.\n\n| h |",
+        reference.map_or("—".into(), |r| format!("{:.6}", r.value)),
+        reference.map_or("no converged case", |r| r.description.as_str())
+    );
+    for p in &ppcs {
+        let _ = write!(s, " iGIMP {} |", ppc_label(*p));
+    }
+    for m in &fems {
+        let _ = write!(s, " {} |", m.label());
+    }
+    let _ = write!(s, "\n|---:|");
+    for _ in 0..ppcs.len() + fems.len() {
+        s.push_str("---:|");
+    }
+    s.push('\n');
+    let cell = |c: Option<&&CompactionRecord>| -> String {
+        match c {
+            None => "—".into(),
+            Some(c) => match (c.status, c.max_horizontal_displacement) {
+                (CaseStatus::Converged, Some(u)) => match reference {
+                    Some(r) => format!("{u:.5} ({:.4})", u / r.value),
+                    None => format!("{u:.5}"),
+                },
+                (CaseStatus::Failed, _) => {
+                    format!("failed at step {}", c.failure.as_ref().map_or(0, |f| f.step))
+                }
+                _ => "rejected".into(),
+            },
+        }
+    };
+    for h in hs {
+        let _ = write!(s, "| {h} |");
+        for p in &ppcs {
+            let c = cases
+                .iter()
+                .find(|c| c.h == h && c.points_per_cell == Some(*p) && results.is_default(c));
+            let _ = write!(s, " {} |", cell(c));
+        }
+        for m in &fems {
+            let _ = write!(
+                s,
+                " {} |",
+                cell(cases.iter().find(|c| c.h == h && c.method == *m))
+            );
+        }
+        s.push('\n');
+    }
+    s.push('\n');
+    s
+}
+
+fn cases_table(results: &CompactionResults) -> String {
+    let mut s = String::from(
+        "## All cases\n\n| case | method | h | points/cell | ρ_y | weak-node tol. | ghost γ | status | max horizontal u | weak nodes treated | steps cut (attempts failed) | Newton its/step |\n|---|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|\n",
+    );
+    for c in &results.cases {
+        let u = c
+            .max_horizontal_displacement
+            .map(|u| format!("{u:.6}"))
+            .or_else(|| {
+                c.last_converged_displacement
+                    .map(|u| format!("({u:.4} at last converged step)"))
+            })
+            .unwrap_or("—".into());
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            c.id,
+            c.method.label(),
+            c.h,
+            c.points_per_cell.map_or("—".into(), |p| format!("{p}×{p}")),
+            c.yield_stress.map_or("elastic".into(), number),
+            c.weak_node_tolerance,
+            if c.method.is_fem() {
+                "—".into()
+            } else if c.ghost_gamma > 0.0 && c.ghost_faces == crate::ghost::GhostFaces::All {
+                format!("{} (all faces)", number(c.ghost_gamma))
+            } else {
+                number(c.ghost_gamma)
+            },
+            plane::status_word(c.status),
+            u,
+            c.weak_nodes_treated,
+            if c.steps_cut == 0 {
+                "0".into()
+            } else {
+                format!("{} ({})", c.steps_cut, c.cutbacks)
+            },
+            if c.steps.is_empty() {
+                "—".into()
+            } else {
+                format!("{:.2}", c.newton_iterations as f64 / c.steps.len() as f64)
+            }
+        );
+    }
+    s.push('\n');
+    s
+}
+
+/// The main report.
+pub fn report_markdown(results: &CompactionResults) -> String {
+    let spec = &results.study;
+    let (pass, fail, none) = plane::check_counts(&results.checks);
+    let count = |st| results.cases.iter().filter(|c| c.status == st).count();
+    let mut s = format!(
+        "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated. Cases: {} converged, {} failed, {} rejected.\n\n",
+        spec.name,
+        spec.summary,
+        results.provenance.line(),
+        count(CaseStatus::Converged),
+        count(CaseStatus::Failed),
+        count(CaseStatus::Rejected)
+    );
+    s.push_str(&figure17_table(results));
+    s.push_str(&plane::checks_markdown(&results.checks));
+    for p in &spec.paper_residuals {
+        let _ = writeln!(s, "- {}: [{}]({})", p.table, p.title, p.file);
+    }
+    s.push('\n');
+    s.push_str(&cases_table(results));
+    s.push_str(&plane::failures_markdown(
+        results
+            .cases
+            .iter()
+            .map(|c| (c.id.as_str(), c.status, c.failure.as_ref())),
+    ));
+    if !spec.figures.is_empty() {
+        s.push_str("## Figures\n\n");
+        for f in &spec.figures {
+            let _ = writeln!(s, "### {}\n\n![{}]({}.svg)\n", f.title, f.id, f.id);
+        }
+    }
+    s
+}
+
+fn figure_error(dir: &Path, id: &str) -> impl Fn(String) -> StudyError {
+    let path = dir.join(format!("{id}.svg")).display().to_string();
+    move |message| StudyError::Io {
+        path: path.clone(),
+        message,
+    }
+}
+
+fn render_figure(
+    results: &CompactionResults,
+    domains: &BTreeMap<String, Vec<DomainRecord>>,
+    dir: &Path,
+    f: &CompactionFigure,
+) -> Result<Option<String>, StudyError> {
+    let fail = figure_error(dir, &f.id);
+    let case = match (f.element_size, f.points_per_cell) {
+        (Some(h), Some(p)) => results.igimp_case(&f.sweep, h, p as usize),
+        _ => None,
+    };
+    match f.kind {
+        CompactionFigureKind::Domains => {
+            let Some(points) = case.and_then(|c| domains.get(&c.id)) else {
+                return Ok(None);
+            };
+            let c = case.expect("checked above");
+            let initial = points
+                .iter()
+                .map(|d| Domain {
+                    centre: d.x0,
+                    half: d.half0,
+                })
+                .collect();
+            let current = points
+                .iter()
+                .map(|d| Domain {
+                    centre: d.x,
+                    half: d.half,
+                })
+                .collect();
+            let title = match c.status {
+                CaseStatus::Converged => f.title.clone(),
+                _ => format!("{} (last converged step)", f.title),
+            };
+            domains_svg(
+                &title,
+                "σyy",
+                &[
+                    DomainLayer {
+                        label: "initial".into(),
+                        domains: initial,
+                        values: None,
+                        colour: None,
+                    },
+                    DomainLayer {
+                        label: String::new(),
+                        domains: current,
+                        values: Some(points.iter().map(|d| d.sigma_yy).collect()),
+                        colour: Some(0),
+                    },
+                ],
+                &[],
+            )
+            .map(Some)
+            .map_err(fail)
+        }
+        CompactionFigureKind::Residuals => {
+            let step = f.step.unwrap_or(1) as usize;
+            let Some(rec) = case.and_then(|c| c.steps.iter().find(|r| r.step == step)) else {
+                return Ok(None);
+            };
+            let code: Vec<(f64, f64)> = rec
+                .residuals
+                .iter()
+                .enumerate()
+                .skip(1)
+                .map(|(k, &r)| (k as f64, r))
+                .collect();
+            let mut series = vec![XySeries {
+                label: format!("this code, load step {step}"),
+                points: code,
+                line: true,
+                markers: true,
+            }];
+            for p in results.study.paper_residuals.iter().filter(|p| {
+                p.sweep == f.sweep
+                    && Some(p.element_size) == f.element_size
+                    && Some(p.points_per_cell) == f.points_per_cell
+            }) {
+                if let Some(j) = p.steps.iter().position(|&s| s as usize == step) {
+                    series.push(XySeries {
+                        label: format!("paper {}, load step {step}", p.table),
+                        points: p.residuals[j]
+                            .iter()
+                            .enumerate()
+                            .map(|(k, &r)| ((k + 1) as f64, r))
+                            .collect(),
+                        line: true,
+                        markers: true,
+                    });
+                }
+            }
+            let axes = XyAxes {
+                x_desc: "Newton iteration".into(),
+                y_desc: "normalised out-of-balance force".into(),
+                log_x: false,
+                log_y: true,
+                y_lines: vec![],
+                legend: LegendCorner::UpperRight,
+            };
+            xy_svg(&f.title, &axes, &series).map(Some).map_err(fail)
+        }
+        CompactionFigureKind::DisplacementConvergence => {
+            let Some(reference) = &results.reference else {
+                return Ok(None);
+            };
+            let cases = results.sweep(&f.sweep);
+            let mut groups: BTreeMap<SeriesKey, Vec<(f64, f64)>> = BTreeMap::new();
+            for c in cases.iter().filter(|c| results.is_default(c)) {
+                if let Some(u) = c.max_horizontal_displacement {
+                    groups
+                        .entry((c.method, c.points_per_cell))
+                        .or_default()
+                        .push((c.h, u / reference.value));
+                }
+            }
+            let series: Vec<XySeries> = groups
+                .into_iter()
+                .map(|((m, p), pts)| XySeries {
+                    label: match p {
+                        Some(p) => format!("{}, {}", m.label(), ppc_label(p)),
+                        None => m.label().to_string(),
+                    },
+                    points: pts,
+                    line: true,
+                    markers: true,
+                })
+                .collect();
+            let axes = XyAxes {
+                x_desc: "element size h".into(),
+                y_desc: "u_max / u_ref".into(),
+                log_x: true,
+                log_y: false,
+                y_lines: vec![(0.99, "−1 %".into()), (1.01, "+1 %".into())],
+                legend: LegendCorner::LowerLeft,
+            };
+            // The full description is in the report; the title only names the reference.
+            let short = match (reference.method, reference.observed_order) {
+                (PlaneMethod::Igimp, _) => "finest iGIMP (no FEM)".to_string(),
+                (m, Some(_)) => format!("{}, extrapolated", m.label()),
+                (m, None) => format!("finest {}", m.label()),
+            };
+            let title = format!("{} (u_ref: {short})", f.title);
+            xy_svg(&title, &axes, &series).map(Some).map_err(fail)
+        }
+    }
+}
+
+/// A Figure 17 series: method and points per cell.
+type SeriesKey = (PlaneMethod, Option<usize>);
+
+/// Render the report, the residual tables and the figures from `dir`'s `results.json` and
+/// `domains.json`. Returns the files written.
+pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+    let results = read_results(dir)?;
+    let domains: BTreeMap<String, Vec<DomainRecord>> = plane::read_json(&dir.join("domains.json"))?;
+    let mut written = vec![];
+    plane::write_text(
+        &dir.join(&results.study.report_file),
+        &report_markdown(&results),
+        &mut written,
+    )?;
+    for p in &results.study.paper_residuals {
+        plane::write_text(&dir.join(&p.file), &residual_table(&results, p), &mut written)?;
+    }
+    for f in &results.study.figures {
+        if let Some(svg) = render_figure(&results, &domains, dir, f)? {
+            plane::write_text(&dir.join(format!("{}.svg", f.id)), &svg, &mut written)?;
+        }
+    }
+    Ok(written)
+}
+
+pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
+    let r = read_results(dir)?;
+    let mut files = vec![("report".to_string(), r.study.report_file.clone())];
+    files.extend(
+        r.study
+            .paper_residuals
+            .iter()
+            .map(|p| (format!("{}: {}", p.table, p.title), p.file.clone())),
+    );
+    files.extend(
+        r.study
+            .figures
+            .iter()
+            .map(|f| (f.title.clone(), format!("{}.svg", f.id))),
+    );
+    Ok(IndexEntry {
+        name: r.study.name,
+        summary: r.study.summary,
+        tier: r.provenance.tier,
+        checks: r.checks,
+        files,
+    })
+}
+
+/// A number as the case ids write it (shortest round-trip form).
+fn number(x: f64) -> String {
+    format!("{x}")
+}
