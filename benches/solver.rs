@@ -15,7 +15,8 @@ use igimp::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement}
 use igimp::grid::Grid;
 use igimp::kinematics::{evaluate_point, PointState};
 use igimp::linear::LinearSolver;
-use igimp::newton::{LoadStepping, NonlinearSystem};
+use igimp::load_stepping::LoadStepping;
+use igimp::newton::NonlinearSystem;
 use igimp::problems::column::ColumnSpec;
 use nalgebra::{SMatrix, SVector};
 use serde::Deserialize;

@@ -46,6 +46,7 @@ pub mod ghost;
 pub mod grid;
 pub mod kinematics;
 pub mod linear;
+pub mod load_stepping;
 pub mod mpm;
 pub mod newton;
 pub mod norms;

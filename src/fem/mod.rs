@@ -59,7 +59,8 @@ pub use updated_lagrangian::{validate_stepping, FemMesh, GaussPoints, MAX_LOAD_S
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_finite, InputError, StepFailure};
-use crate::newton::{Increment, LoadStepping, NewtonSettings};
+use crate::load_stepping::{Increment, LoadStepping};
+use crate::newton::NewtonSettings;
 use crate::quadrature::GaussRule;
 use nalgebra::SVector;
 use updated_lagrangian::{fem_advance, fem_step_system, UlCore};

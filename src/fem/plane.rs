@@ -10,7 +10,8 @@ use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_finite, InputError, StepFailure};
 use crate::linear::LinearSolver;
-use crate::newton::{Increment, LoadStepping, NewtonSettings};
+use crate::load_stepping::{Increment, LoadStepping};
+use crate::newton::NewtonSettings;
 use nalgebra::{Matrix3, SVector};
 use serde::{Deserialize, Serialize};
 

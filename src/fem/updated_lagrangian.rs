@@ -8,7 +8,8 @@ use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, InputError, StepFailure};
 use crate::kinematics::PointState;
-use crate::newton::{Increment, NewtonSettings};
+use crate::load_stepping::Increment;
+use crate::newton::NewtonSettings;
 use nalgebra::SVector;
 
 /// Most load steps an analysis may ask for.

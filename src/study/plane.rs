@@ -16,8 +16,8 @@
 use super::runner::{CaseStatus, FailureRecord, Software, StepRecord};
 use super::{StudyError, Tier};
 use crate::error::SolveError;
+use crate::load_stepping::StepReport;
 use crate::mpm::WeakNodeTreatment;
-use crate::newton::StepReport;
 use rayon::prelude::*;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};

@@ -2,7 +2,7 @@
 //! the MPM-vs-GIMP stress error of Figure 8, and input validation.
 
 use igimp::basis::Basis;
-use igimp::newton::LoadStepping;
+use igimp::load_stepping::LoadStepping;
 use igimp::newton::{check_quadratic, NewtonSettings};
 use igimp::problems::column::{f_from_cauchy_stress, solve_column, ColumnSpec, Method};
 

@@ -6,7 +6,7 @@
 
 use igimp::constitutive::LinearElastic;
 use igimp::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
-use igimp::newton::LoadStepping;
+use igimp::load_stepping::LoadStepping;
 use igimp::newton::{observed_order, NewtonSettings, NonlinearSystem};
 use igimp::norms::fitted_rate;
 use igimp::problems::column::{f_from_cauchy_stress, ColumnOutcome, ColumnSpec};

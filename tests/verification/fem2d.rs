@@ -16,7 +16,8 @@ use igimp::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
 use igimp::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
 use igimp::kinematics::{left_cauchy_green_from_strain, log_strain};
 use igimp::linear::LinearSolver;
-use igimp::newton::{check_quadratic, LoadStepping, NonlinearSystem};
+use igimp::load_stepping::LoadStepping;
+use igimp::newton::{check_quadratic, NonlinearSystem};
 use nalgebra::{Matrix2, Matrix3, SVector};
 
 type V2 = SVector<f64, 2>;

@@ -513,7 +513,7 @@ proptest! {
         };
         let solver = no_panic("CompactionSpec::mpm_solver", || spec.mpm_solver())?;
         if let Some(mut s) = solver {
-            use igimp::newton::LoadStepping;
+            use igimp::load_stepping::LoadStepping;
             if s.points.len() <= 200 && s.grid.num_nodes() <= 400 && newton.max_iterations <= 40 {
                 let _ = catch_unwind(AssertUnwindSafe(|| s.step()))
                     .map_err(|_| TestCaseError::fail(format!("compaction step panicked: {spec:?}")))?;

@@ -13,8 +13,8 @@ use igimp::kinematics::{
     dlog, evaluate_point, left_cauchy_green_from_strain, log_strain, sym_eigen, PointState,
 };
 use igimp::linear::SparseSystem;
+use igimp::load_stepping::LoadStepping;
 use igimp::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
-use igimp::newton::LoadStepping;
 use igimp::newton::{NewtonSettings, NonlinearSystem};
 use igimp::particles::MaterialPoints;
 use igimp::problems::column::ColumnSpec;
