@@ -152,7 +152,7 @@ fn run_plane(file: &Path, cli: &Cli) -> Result<Option<bool>, StudyError> {
     let Ok(text) = std::fs::read_to_string(file) else {
         return Ok(None);
     };
-    let Some(problem) = plane::problem_of_study(&text).filter(|p| plane::is_plane_problem(p)) else {
+    let Some(problem) = plane::problem_of_study(&text).filter(|p| registry::is_plane_problem(p)) else {
         return Ok(None);
     };
     let tier = if cli.quick { Tier::Quick } else { Tier::Full };

@@ -535,11 +535,7 @@ pub fn problem_of_results(dir: &Path) -> Option<String> {
     v.get("study")?.get("problem")?.as_str().map(str::to_string)
 }
 
-/// True for the problems handled here rather than by the column study.
-pub fn is_plane_problem(problem: &str) -> bool {
-    matches!(problem, "compaction" | "cantilever")
-}
-
+/// Write `value` as JSON (pretty or compact), atomically.
 pub fn write_json<T: Serialize>(path: &Path, value: &T, pretty: bool) -> Result<(), StudyError> {
     let text = if pretty {
         serde_json::to_string_pretty(value)

@@ -1,6 +1,7 @@
 //! The registry of plane-strain study kinds: which kind a study file or a results folder
 //! holds (its `problem` key), and the kind's parse, run, render and index functions. Adding a
-//! plane-strain study kind is one arm in each function here.
+//! plane-strain study kind is one `plane_kind!` line (its study, run and module) and one
+//! entry in [`KINDS`].
 
 use super::plane::{
     check_counts, invalid, problem_of_results, problem_of_study, IndexEntry, PlaneRunOptions, PlaneStudy,
@@ -21,6 +22,8 @@ pub trait PlaneKind: PlaneStudy {
         tier: Tier,
         options: &PlaneRunOptions<'_>,
     ) -> Result<Self::Run, StudyError>;
+    /// The study's one-line summary (`study list`).
+    fn study_summary(&self) -> &str;
     /// Write results.json and the domain file; returns the folder.
     fn write(out: &Path, run: &Self::Run) -> Result<PathBuf, StudyError>;
     fn summary(run: &Self::Run) -> RunSummary;
@@ -34,6 +37,9 @@ macro_rules! plane_kind {
             type Run = $run;
             fn study_name(&self) -> &str {
                 &self.name
+            }
+            fn study_summary(&self) -> &str {
+                &self.summary
             }
             fn run(
                 &self,
@@ -55,6 +61,52 @@ macro_rules! plane_kind {
 
 plane_kind!(compaction::CompactionStudy, compaction::CompactionRun, compaction);
 plane_kind!(cantilever::CantileverStudy, cantilever::CantileverRun, cantilever);
+
+/// Parse, solve and write one study file: its folder and summary (none with `render_only`).
+type RunFn =
+    for<'a, 'b> fn(&Request<'a>, PlaneRunOptions<'b>) -> Result<(PathBuf, Option<RunSummary>), StudyError>;
+/// (name, summary) of a study file's text, for `study list`.
+type CatalogueFn = fn(&str, &str) -> Result<(String, String), StudyError>;
+
+/// One registered kind: its `problem` key and what `study` does with it.
+struct Entry {
+    problem: &'static str,
+    run: RunFn,
+    catalogue: CatalogueFn,
+    render: fn(&Path) -> Result<Vec<PathBuf>, StudyError>,
+    index: fn(&Path) -> Result<IndexEntry, StudyError>,
+}
+
+/// Every plane-strain study kind.
+const KINDS: &[Entry] = &[
+    Entry {
+        problem: "compaction",
+        run: run_kind::<compaction::CompactionStudy>,
+        catalogue: catalogue_of::<compaction::CompactionStudy>,
+        render: crate::render::compaction::render,
+        index: crate::render::compaction::index_entry,
+    },
+    Entry {
+        problem: "cantilever",
+        run: run_kind::<cantilever::CantileverStudy>,
+        catalogue: catalogue_of::<cantilever::CantileverStudy>,
+        render: crate::render::cantilever::render,
+        index: crate::render::cantilever::index_entry,
+    },
+];
+
+fn kind(problem: &str) -> Option<&'static Entry> {
+    KINDS.iter().find(|k| k.problem == problem)
+}
+
+/// Is `problem` a plane-strain study kind?
+pub fn is_plane_problem(problem: &str) -> bool {
+    kind(problem).is_some()
+}
+
+fn catalogue_of<K: PlaneKind>(text: &str, shown: &str) -> Result<(String, String), StudyError> {
+    K::parse(text, shown).map(|s| (s.study_name().to_string(), s.study_summary().to_string()))
+}
 
 /// What `study` asks of one study file.
 struct Request<'a> {
@@ -114,28 +166,25 @@ pub fn run_file(
         out,
         render_only,
     };
-    let (dir, summary) = match problem {
-        "compaction" => run_kind::<compaction::CompactionStudy>(&request, options)?,
-        "cantilever" => run_kind::<cantilever::CantileverStudy>(&request, options)?,
-        other => {
-            return Err(invalid(
-                &shown,
-                "problem",
-                format!("{other:?}"),
-                "must be column, compaction or cantilever",
-            ))
-        }
+    let Some(k) = kind(problem) else {
+        let known: Vec<&str> = KINDS.iter().map(|k| k.problem).collect();
+        return Err(invalid(
+            &shown,
+            "problem",
+            format!("{problem:?}"),
+            format!("must be column or {}", known.join(", ")),
+        ));
     };
+    let (dir, summary) = (k.run)(&request, options)?;
     let files = render_dir(&dir)?;
     Ok((dir, summary, files))
 }
 
 /// Render the tables and figures of a plane-strain study folder from its results.
 pub fn render_dir(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
-    match problem_of_results(dir).as_deref() {
-        Some("compaction") => crate::render::compaction::render(dir),
-        Some("cantilever") => crate::render::cantilever::render(dir),
-        _ => Err(StudyError::io(
+    match problem_of_results(dir).as_deref().and_then(kind) {
+        Some(k) => (k.render)(dir),
+        None => Err(StudyError::io(
             &dir.join("results.json"),
             "not a plane-strain study result",
         )),
@@ -144,10 +193,9 @@ pub fn render_dir(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
 
 /// The index entry of a plane-strain study folder; `None` for other studies.
 pub fn index_entry(dir: &Path) -> Result<Option<IndexEntry>, StudyError> {
-    match problem_of_results(dir).as_deref() {
-        Some("compaction") => crate::render::compaction::index_entry(dir).map(Some),
-        Some("cantilever") => crate::render::cantilever::index_entry(dir).map(Some),
-        _ => Ok(None),
+    match problem_of_results(dir).as_deref().and_then(kind) {
+        Some(k) => (k.index)(dir).map(Some),
+        None => Ok(None),
     }
 }
 
@@ -159,10 +207,6 @@ pub fn folder_check_counts(dir: &Path) -> Result<(usize, usize, usize), StudyErr
 /// (name, summary) of a plane-strain study file for `study list`; `None` for other studies.
 pub fn catalogue_entry(file: &Path) -> Option<Result<(String, String), StudyError>> {
     let text = std::fs::read_to_string(file).ok()?;
-    let shown = file.display().to_string();
-    match problem_of_study(&text)?.as_str() {
-        "compaction" => Some(compaction::CompactionStudy::parse(&text, &shown).map(|s| (s.name, s.summary))),
-        "cantilever" => Some(cantilever::CantileverStudy::parse(&text, &shown).map(|s| (s.name, s.summary))),
-        _ => None,
-    }
+    let k = kind(&problem_of_study(&text)?)?;
+    Some((k.catalogue)(&text, &file.display().to_string()))
 }
