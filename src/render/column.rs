@@ -3,8 +3,9 @@
 //! `study --render-only` reproduces them byte for byte.
 
 use crate::plot::{self, ConvergenceSeries, ProfileSeries};
-use crate::problems::column::{ColumnSpec, Method};
+use crate::problems::column::Method;
 use crate::study::rates::{case_error, pairwise_rates, series};
+use crate::study::results::AnalyticalRecord;
 use crate::study::runner::{
     points_file, read_points_csv, read_results, CaseRecord, CaseStatus, StudyResults,
 };
@@ -49,18 +50,14 @@ fn status_word(c: &CaseRecord) -> &'static str {
     }
 }
 
-/// The column of a load (for its analytical solution, `ColumnSpec::analytical`).
-pub fn column_at(results: &StudyResults, load: f64) -> ColumnSpec {
-    let c = &results.study.column;
-    ColumnSpec {
-        length: c.length,
-        young_modulus: c.young_modulus,
-        poisson_ratio: c.poisson_ratio,
-        density: c.density,
-        yield_stress: c.yield_stress,
-        weight: load,
-        ..ColumnSpec::default()
-    }
+/// The analytical column at `load` as the run recorded it.
+fn analytical_at(results: &StudyResults, load: f64) -> Result<&AnalyticalRecord, StudyError> {
+    results.analytical_at(load).ok_or_else(|| StudyError::Parse {
+        file: "results.json".into(),
+        message: format!(
+            "no analytical record for W = {load} (results written by an older igimp: solve again)"
+        ),
+    })
 }
 
 /// The (method, points per cell) series of a sweep at one load, in plan order.
@@ -131,8 +128,15 @@ pub fn report_markdown(results: &StudyResults) -> String {
 
     for p in &spec.paper {
         let ppc = p.points_per_cell.map(|n| n as usize);
-        let exact = column_at(results, p.weight).analytical();
-        let f0 = exact.deformation_gradient(0.0);
+        let Some(exact) = results.analytical_at(p.weight) else {
+            let _ = writeln!(
+                s,
+                "## {}: no analytical record for W = {} in results.json (solve again)\n",
+                p.table, p.weight
+            );
+            continue;
+        };
+        let f0 = exact.base_f;
         let _ = writeln!(
             s,
             "## {}: {}, W = {}{}\n",
@@ -146,11 +150,7 @@ pub fn report_markdown(results: &StudyResults) -> String {
             "Analytical: top displacement u(L0) = {:.6}, base F(0) = {:.8} (the paper prints {}). \
              F error is eq (47); the paper's values match |F − {}| / {} with its rounded F(0), \
              so both are shown.\n",
-            exact.displacement(results.study.column.length),
-            f0,
-            p.analytical_base_f,
-            p.analytical_base_f,
-            p.analytical_base_f
+            exact.top_displacement, f0, p.analytical_base_f, p.analytical_base_f, p.analytical_base_f
         );
         let ids = results.sweep_cases.of_sweep(&p.sweep);
         let cases: Vec<Option<&CaseRecord>> = p
@@ -218,7 +218,7 @@ pub fn report_markdown(results: &StudyResults) -> String {
         s.push('\n');
     }
 
-    if let Some(ry) = spec.column.yield_stress {
+    if spec.column.yield_stress.is_some() {
         let _ = writeln!(s, "## Yield height\n");
         let _ = writeln!(
             s,
@@ -235,9 +235,9 @@ pub fn report_markdown(results: &StudyResults) -> String {
         loads.sort_by(f64::total_cmp);
         loads.dedup();
         for load in loads {
-            let column = column_at(results, load);
-            let exact = column.analytical().yield_height();
-            let paper = column.length - ry / (column.density * column.gravity());
+            let a = results.analytical_at(load);
+            let exact = a.and_then(|a| a.yield_height);
+            let paper = a.and_then(|a| a.paper_yield_height).unwrap_or(f64::NAN);
             let finest = results
                 .cases
                 .iter()
@@ -482,16 +482,12 @@ pub fn render_figure(
                     });
                 }
             }
-            let column = column_at(results, fig.weight);
-            let exact = column.analytical();
-            let l0 = results.study.column.length;
-            let z0s: Vec<f64> = (0..=400).map(|i| l0 * i as f64 / 400.0).collect();
-            let height = |z0: f64| z0 + exact.displacement(z0);
+            let exact = analytical_at(results, fig.weight)?;
             let mut curves = vec![ProfileSeries {
                 label: "analytical σzz, eqs (42)-(45)".into(),
-                points: z0s.iter().map(|&z0| (exact.stress(z0), height(z0))).collect(),
+                points: exact.profile.iter().map(|r| (r[2], r[1])).collect(),
             }];
-            let plastic = column.yield_stress.is_some();
+            let plastic = results.study.column.yield_stress.is_some();
             if plastic {
                 // The lateral stress is recorded in the sixth column of plastic point files.
                 for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {
@@ -512,10 +508,7 @@ pub fn render_figure(
                 }
                 curves.push(ProfileSeries {
                     label: "analytical σxx = σyy (derived; eq 54)".into(),
-                    points: z0s
-                        .iter()
-                        .map(|&z0| (exact.lateral_stress(z0), height(z0)))
-                        .collect(),
+                    points: exact.profile.iter().map(|r| (r[3], r[1])).collect(),
                 });
             }
             plot::profile_svg(

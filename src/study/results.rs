@@ -106,10 +106,39 @@ pub struct StudyResults {
     pub cases: Vec<CaseRecord>,
     pub rates: Vec<RateRecord>,
     pub comparisons: Vec<ComparisonRecord>,
+    /// The analytical column at every load the cases, tables and figures use, evaluated when
+    /// the study is solved (so that rendering reads only this file).
+    #[serde(default)]
+    pub analytical: Vec<AnalyticalRecord>,
     pub timing: Timing,
 }
 
+/// Samples of the analytical profile ([`AnalyticalRecord::profile`]): 401 equally spaced
+/// reference heights, 0 to L0.
+pub const PROFILE_SAMPLES: usize = 400;
+
+/// The analytical column (eqs 42–45, Appendix A) at one load.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AnalyticalRecord {
+    pub load: f64,
+    /// u(L0).
+    pub top_displacement: f64,
+    /// F(0), the base deformation gradient of eq (47).
+    pub base_f: f64,
+    /// Height where yield starts (Kirchhoff criterion); `None` if elastic throughout.
+    pub yield_height: Option<f64>,
+    /// The paper's L0 − ρy/(ρ0 g) (Cauchy criterion), for plastic studies.
+    pub paper_yield_height: Option<f64>,
+    /// (Z, z = Z + u(Z), σzz, σxx) at [`PROFILE_SAMPLES`] + 1 reference heights Z.
+    pub profile: Vec<[f64; 4]>,
+}
+
 impl StudyResults {
+    /// The analytical column at `load`, if the run recorded it.
+    pub fn analytical_at(&self, load: f64) -> Option<&AnalyticalRecord> {
+        self.analytical.iter().find(|a| a.load == load)
+    }
+
     pub fn case(&self, id: &str) -> Option<&CaseRecord> {
         self.cases.iter().find(|c| c.id == id)
     }

@@ -10,6 +10,7 @@
 //! case and the `timing` block).
 
 use super::rates::{compute_comparisons, compute_rates};
+use super::results::{AnalyticalRecord, PROFILE_SAMPLES};
 pub use super::results::{
     CaseRecord, CaseStatus, FailureRecord, Software, StepRecord, StudyResults, Timing, POINTS_HEADER,
     POINTS_HEADER_PLASTIC,
@@ -308,6 +309,7 @@ fn run_cases(
     let index = spec.case_index(tier);
     let rates = compute_rates(spec, tier, &records, &index);
     let comparisons = compute_comparisons(spec, tier, &records, &index);
+    let analytical = analytical_records(spec, &records);
     Ok(StudyRun {
         results: StudyResults {
             software: Software {
@@ -321,6 +323,7 @@ fn run_cases(
             cases: records,
             rates,
             comparisons,
+            analytical,
             timing: Timing {
                 wall_seconds: start.elapsed().as_secs_f64(),
                 threads: rayon::current_num_threads(),
@@ -329,6 +332,55 @@ fn run_cases(
         points,
         resumed: resumed.into_inner(),
     })
+}
+
+/// The analytical column at every load of the cases, paper tables and figures.
+fn analytical_records(spec: &StudySpec, cases: &[CaseRecord]) -> Vec<AnalyticalRecord> {
+    let mut loads: Vec<f64> = cases
+        .iter()
+        .map(|c| c.load)
+        .chain(spec.paper.iter().map(|p| p.weight))
+        .chain(spec.figures.iter().map(|f| f.weight))
+        .collect();
+    loads.sort_by(f64::total_cmp);
+    loads.dedup();
+    let c = &spec.column;
+    loads
+        .into_iter()
+        .map(|load| {
+            let column = ColumnSpec {
+                length: c.length,
+                young_modulus: c.young_modulus,
+                poisson_ratio: c.poisson_ratio,
+                density: c.density,
+                yield_stress: c.yield_stress,
+                weight: load,
+                ..ColumnSpec::default()
+            };
+            let exact = column.analytical();
+            let profile = (0..=PROFILE_SAMPLES)
+                .map(|i| {
+                    let z0 = c.length * i as f64 / PROFILE_SAMPLES as f64;
+                    [
+                        z0,
+                        z0 + exact.displacement(z0),
+                        exact.stress(z0),
+                        exact.lateral_stress(z0),
+                    ]
+                })
+                .collect();
+            AnalyticalRecord {
+                load,
+                top_displacement: exact.displacement(c.length),
+                base_f: exact.deformation_gradient(0.0),
+                yield_height: exact.yield_height(),
+                paper_yield_height: c
+                    .yield_stress
+                    .map(|ry| column.length - ry / (column.density * column.gravity())),
+                profile,
+            }
+        })
+        .collect()
 }
 
 /// Folder of a study's outputs: `<out>/<name>`.
