@@ -267,34 +267,25 @@ fn render_figure(
 pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
     let results = read_results(dir)?;
     let snapshots: BTreeMap<String, Vec<DomainSnapshot>> = plane::read_json(&dir.join("domains.json"))?;
-    let mut written = vec![];
-    plane::write_text(
-        &dir.join(&results.study.report_file),
-        &report_markdown(&results),
-        &mut written,
-    )?;
-    for f in &results.study.figures {
-        if let Some(svg) = render_figure(&results, &snapshots, dir, f)? {
-            plane::write_text(&dir.join(format!("{}.svg", f.id)), &svg, &mut written)?;
-        }
-    }
-    Ok(written)
+    let figures =
+        results.study.figures.iter().map(|f| {
+            render_figure(&results, &snapshots, dir, f).map(|svg| svg.map(|svg| (f.id.clone(), svg)))
+        });
+    super::write_plane_files(
+        dir,
+        (&results.study.report_file, report_markdown(&results)),
+        std::iter::empty(),
+        figures,
+    )
 }
 
 pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
     let r = read_results(dir)?;
-    let mut files = vec![("report".to_string(), r.study.report_file.clone())];
-    files.extend(
-        r.study
-            .figures
-            .iter()
-            .map(|f| (f.title.clone(), format!("{}.svg", f.id))),
-    );
-    Ok(IndexEntry {
-        name: r.study.name,
-        summary: r.study.summary,
-        tier: r.provenance.tier,
-        checks: r.checks,
-        files,
-    })
+    Ok(super::plane_index_entry(
+        (r.study.name.clone(), r.study.summary.clone(), r.provenance.tier),
+        r.checks.clone(),
+        &r.study.report_file,
+        std::iter::empty(),
+        r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
+    ))
 }

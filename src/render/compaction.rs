@@ -394,45 +394,36 @@ type SeriesKey = (PlaneMethod, Option<usize>);
 pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
     let results = read_results(dir)?;
     let domains: BTreeMap<String, Vec<DomainRecord>> = plane::read_json(&dir.join("domains.json"))?;
-    let mut written = vec![];
-    plane::write_text(
-        &dir.join(&results.study.report_file),
-        &report_markdown(&results),
-        &mut written,
-    )?;
-    for p in &results.study.paper_residuals {
-        plane::write_text(&dir.join(&p.file), &residual_table(&results, p), &mut written)?;
-    }
-    for f in &results.study.figures {
-        if let Some(svg) = render_figure(&results, &domains, dir, f)? {
-            plane::write_text(&dir.join(format!("{}.svg", f.id)), &svg, &mut written)?;
-        }
-    }
-    Ok(written)
+    let tables = results
+        .study
+        .paper_residuals
+        .iter()
+        .map(|p| (p.file.clone(), residual_table(&results, p)));
+    let figures = results
+        .study
+        .figures
+        .iter()
+        .map(|f| render_figure(&results, &domains, dir, f).map(|svg| svg.map(|svg| (f.id.clone(), svg))));
+    super::write_plane_files(
+        dir,
+        (&results.study.report_file, report_markdown(&results)),
+        tables,
+        figures,
+    )
 }
 
 pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
     let r = read_results(dir)?;
-    let mut files = vec![("report".to_string(), r.study.report_file.clone())];
-    files.extend(
+    Ok(super::plane_index_entry(
+        (r.study.name.clone(), r.study.summary.clone(), r.provenance.tier),
+        r.checks.clone(),
+        &r.study.report_file,
         r.study
             .paper_residuals
             .iter()
             .map(|p| (format!("{}: {}", p.table, p.title), p.file.clone())),
-    );
-    files.extend(
-        r.study
-            .figures
-            .iter()
-            .map(|f| (f.title.clone(), format!("{}.svg", f.id))),
-    );
-    Ok(IndexEntry {
-        name: r.study.name,
-        summary: r.study.summary,
-        tier: r.provenance.tier,
-        checks: r.checks,
-        files,
-    })
+        r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
+    ))
 }
 
 /// A number as the case ids write it (shortest round-trip form).
