@@ -10,6 +10,7 @@
 use crate::basis::Basis;
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, require_positive, InputError, SolveError};
+use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
 use crate::ghost::{GhostFaces, GhostSettings};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
@@ -231,5 +232,55 @@ pub fn solve_mpm(spec: &CompactionSpec) -> Result<CompactionOutcome, InputError>
         failure,
         max_horizontal_displacement,
         points,
+    })
+}
+
+/// What the FEM comparator reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FemOutcome {
+    pub steps: Vec<StepReport>,
+    pub failure: Option<SolveError>,
+    /// Horizontal displacement of the bottom-right node.
+    pub max_horizontal_displacement: f64,
+    pub elements: usize,
+}
+
+/// Updated-Lagrangian FEM of the modelled half block with the same supports (roller on
+/// x = 0, u_y = 0 on the base), material and gravity ramp: Q4 with 2×2 Gauss points (the
+/// paper's Figure 17 reference) or Q8 with 3×3 (a comparison for plastic flow, where Q4
+/// locks). LDLᵀ solves.
+pub fn solve_fem(spec: &CompactionSpec, element: QuadElement) -> Result<FemOutcome, InputError> {
+    let h = spec.element_size;
+    let cells = (
+        (spec.half_width / h).round() as usize,
+        (spec.height / h).round() as usize,
+    );
+    let size = SVector::<f64, 2>::new(spec.half_width, spec.height);
+    let mesh = PlaneMesh::rectangle(SVector::zeros(), size, cells, element)?;
+    let tol = 1e-9 * h;
+    let mut fixed: Vec<(usize, usize)> = mesh.nodes_at(0, 0.0, tol).into_iter().map(|n| (n, 0)).collect();
+    fixed.extend(mesh.nodes_at(1, 0.0, tol).into_iter().map(|n| (n, 1)));
+    let corner = mesh.nearest_node(SVector::<f64, 2>::new(spec.half_width, 0.0));
+    let elements = mesh.num_elements();
+    let loads = PlaneLoads {
+        gravity: SVector::<f64, 2>::new(0.0, -spec.unit_weight()),
+        nodal_forces: vec![],
+    };
+    let settings = PlaneFemSettings {
+        gauss_points: Some(if element == QuadElement::Q4 { 2 } else { 3 }),
+        newton: spec.newton,
+        load_steps: spec.load_steps,
+        linear_solver: LinearSolver::Ldlt,
+    };
+    let mut fem = PlaneFem::try_new(mesh, 1.0, spec.model()?, fixed, loads, settings)?;
+    let (steps, failure) = match fem.run() {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    Ok(FemOutcome {
+        steps,
+        failure,
+        max_horizontal_displacement: fem.displacement(corner)[0],
+        elements,
     })
 }

@@ -17,13 +17,9 @@ use super::runner::{CaseStatus, FailureRecord, StepRecord};
 use super::vtk_output::{write_domain_frames, DomainFrame};
 use super::{NewtonSection, StudyError, Tier};
 use crate::error::SolveError;
-use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads};
-use crate::fem::{PlaneMesh, QuadElement};
-use crate::linear::LinearSolver;
-use crate::load_stepping::LoadStepping;
+use crate::fem::QuadElement;
 use crate::load_stepping::StepReport;
-use crate::problems::compaction::{solve_mpm, CompactionSpec, DomainRecord};
-use nalgebra::SVector;
+use crate::problems::compaction::{solve_fem, solve_mpm, CompactionSpec, DomainRecord};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -220,8 +216,6 @@ pub struct CompactionStudy {
     #[serde(default)]
     pub figures: Vec<CompactionFigure>,
 }
-
-type V2 = SVector<f64, 2>;
 
 /// One case to solve.
 #[derive(Debug, Clone, PartialEq)]
@@ -646,50 +640,6 @@ struct CaseOutcome {
     domains: Vec<DomainRecord>,
 }
 
-/// Updated-Lagrangian Q4 FEM (2×2 Gauss points, LDLᵀ) of the modelled half block with the
-/// same supports, material and gravity ramp: the Figure 17 reference. The measure is the
-/// horizontal displacement of the bottom-right node.
-/// Updated-Lagrangian FEM on the modelled half block: Q4 with 2×2 Gauss points (the paper's
-/// Figure 17 reference) or Q8 with 3×3 (a comparison for plastic flow, where Q4 locks).
-fn solve_fem(spec: &CompactionSpec, element: QuadElement) -> Result<CaseOutcome, String> {
-    let h = spec.element_size;
-    let cells = (
-        (spec.half_width / h).round() as usize,
-        (spec.height / h).round() as usize,
-    );
-    let size = V2::new(spec.half_width, spec.height);
-    let mesh = PlaneMesh::rectangle(V2::zeros(), size, cells, element).map_err(|e| e.to_string())?;
-    let tol = 1e-9 * h;
-    let mut fixed: Vec<(usize, usize)> = mesh.nodes_at(0, 0.0, tol).into_iter().map(|n| (n, 0)).collect();
-    fixed.extend(mesh.nodes_at(1, 0.0, tol).into_iter().map(|n| (n, 1)));
-    let corner = mesh.nearest_node(V2::new(spec.half_width, 0.0));
-    let elements = mesh.num_elements();
-    let loads = PlaneLoads {
-        gravity: V2::new(0.0, -spec.unit_weight()),
-        nodal_forces: vec![],
-    };
-    let settings = PlaneFemSettings {
-        gauss_points: Some(if element == QuadElement::Q4 { 2 } else { 3 }),
-        newton: spec.newton,
-        load_steps: spec.load_steps,
-        linear_solver: LinearSolver::Ldlt,
-    };
-    let model = spec.model().map_err(|e| e.to_string())?;
-    let mut fem = PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings).map_err(|e| e.to_string())?;
-    let (steps, failure) = match fem.run() {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
-    Ok(CaseOutcome {
-        steps,
-        failure,
-        max_horizontal_displacement: fem.displacement(corner)[0],
-        weak_nodes_treated: 0,
-        points: elements,
-        domains: vec![],
-    })
-}
-
 fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
     let s = &case.spec;
     let mut rec = CompactionRecord {
@@ -721,8 +671,23 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
             weak_nodes_treated: o.weak_nodes_treated,
             domains: o.points,
         }),
-        PlaneMethod::FemQ4 => solve_fem(s, QuadElement::Q4),
-        PlaneMethod::FemQ8 => solve_fem(s, QuadElement::Q8),
+        PlaneMethod::FemQ4 | PlaneMethod::FemQ8 => {
+            let element = if case.method == PlaneMethod::FemQ4 {
+                QuadElement::Q4
+            } else {
+                QuadElement::Q8
+            };
+            solve_fem(s, element)
+                .map_err(|e| e.to_string())
+                .map(|o| CaseOutcome {
+                    steps: o.steps,
+                    failure: o.failure,
+                    max_horizontal_displacement: o.max_horizontal_displacement,
+                    weak_nodes_treated: 0,
+                    points: o.elements,
+                    domains: vec![],
+                })
+        }
     };
     match outcome {
         Err(reason) => {
