@@ -19,17 +19,11 @@ use super::plane::{
 use super::runner::{CaseStatus, FailureRecord, StepRecord};
 use super::vtk_output::{write_domain_frames, DomainFrame};
 use super::{NewtonSection, StudyError, Tier};
-use crate::constitutive::LinearElastic;
 use crate::error::SolveError;
-use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads};
-use crate::fem::{PlaneMesh, QuadElement};
-use crate::linear::LinearSolver;
-use crate::load_stepping::LoadStepping;
 use crate::load_stepping::StepReport;
 use crate::mpm::{DomainUpdate, VolumeUpdate};
-use crate::problems::cantilever::{solve_mpm, CantileverSpec, DomainSnapshot, EndDisplacement};
+use crate::problems::cantilever::{solve_fem_q8, solve_mpm, CantileverSpec, DomainSnapshot, EndDisplacement};
 use crate::problems::elastica::{bending_stiffness, Elastica};
-use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -189,8 +183,6 @@ pub struct CantileverStudy {
     #[serde(default)]
     pub figures: Vec<CantileverFigure>,
 }
-
-type V2 = SVector<f64, 2>;
 
 /// One analysis to run.
 #[derive(Debug, Clone, PartialEq)]
@@ -582,73 +574,6 @@ struct CaseOutcome {
     loaded_points: Option<[usize; 2]>,
 }
 
-/// Updated-Lagrangian Q8 FEM (3×3 Gauss points, LDLᵀ) on the same elements (h, so 20×2 for
-/// the paper's beam), the same supports (left edge on rollers, its neutral-axis node pinned)
-/// and the end load as a dead nodal force on the neutral-axis end node, as in the paper
-/// (Figure 21). The end displacement is that node's.
-fn solve_fem_q8(spec: &CantileverSpec) -> Result<CaseOutcome, String> {
-    let h = spec.element_size;
-    let cells = (
-        (spec.length / h).round() as usize,
-        (spec.depth / h).round() as usize,
-    );
-    let mesh = PlaneMesh::rectangle(
-        V2::zeros(),
-        V2::new(spec.length, spec.depth),
-        cells,
-        QuadElement::Q8,
-    )
-    .map_err(|e| e.to_string())?;
-    let axis = 0.5 * spec.depth;
-    let mut fixed: Vec<(usize, usize)> = mesh
-        .nodes_at(0, 0.0, 1e-9 * h)
-        .into_iter()
-        .map(|n| (n, 0))
-        .collect();
-    fixed.push((mesh.nearest_node(V2::new(0.0, axis)), 1));
-    let tip = mesh.nearest_node(V2::new(spec.length, axis));
-    let loads = PlaneLoads {
-        gravity: V2::zeros(),
-        nodal_forces: vec![(tip, V2::new(0.0, -spec.load))],
-    };
-    let settings = PlaneFemSettings {
-        gauss_points: Some(3),
-        newton: spec.newton,
-        load_steps: spec.load_steps,
-        linear_solver: LinearSolver::Ldlt,
-    };
-    let model =
-        Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio).map_err(|e| e.to_string())?);
-    let mut fem = PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings).map_err(|e| e.to_string())?;
-    let mut out = CaseOutcome {
-        steps: vec![],
-        end: vec![],
-        failure: None,
-        snapshots: vec![],
-        min_half_length: vec![],
-        loaded_points: None,
-    };
-    while fem.steps_done() < fem.load_steps() {
-        match fem.step() {
-            Ok(r) => {
-                let d = fem.displacement(tip);
-                out.end.push(EndDisplacement {
-                    step: r.step,
-                    load: spec.load * r.load_factor,
-                    u_over_l: d[0] / spec.length,
-                    v_over_l: d[1] / spec.length,
-                });
-                out.steps.push(r);
-            }
-            Err(e) => {
-                out.failure = Some(e);
-                break;
-            }
-        }
-    }
-    Ok(out)
-}
-
 /// Solve one case, taking domain snapshots every `snapshot_every` steps (0: none).
 fn solve_case_snapshots(
     case: &CantileverCase,
@@ -690,7 +615,14 @@ fn solve_case_snapshots(
                 min_half_length: o.min_half_length,
                 loaded_points: Some(o.loaded_points),
             }),
-        PlaneMethod::FemQ8 => solve_fem_q8(s),
+        PlaneMethod::FemQ8 => solve_fem_q8(s).map_err(|e| e.to_string()).map(|o| CaseOutcome {
+            steps: o.steps,
+            end: o.end,
+            failure: o.failure,
+            snapshots: vec![],
+            min_half_length: vec![],
+            loaded_points: None,
+        }),
         PlaneMethod::FemQ4 => Err("the cantilever study uses Q8 elements (fem-q8)".to_string()),
     };
     let o = match outcome {
