@@ -383,6 +383,18 @@ pub struct StudySpec {
     pub paper: Vec<PaperRows>,
     #[serde(default)]
     pub figures: Vec<FigureSpec>,
+    /// Ghost stabilisation of one point per cell ([`crate::ghost`]); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ghost: Option<ColumnGhost>,
+}
+
+/// A column study's `[ghost]`: the settings of its one-point-per-cell cases (the odd-even
+/// mode of one-point sampling, reference/README.md item 15) and where they come from. Cases
+/// with more points per cell are untreated, so Table 1 is unaffected.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColumnGhost {
+    pub one_point_per_cell: crate::ghost::GhostSettings,
 }
 
 /// True for the methods whose points per cell matter.
@@ -547,6 +559,11 @@ impl StudySpec {
         }
         c.ident("name", &self.name)?;
         c.text("summary", &self.summary)?;
+        if let Some(g) = &self.ghost {
+            g.one_point_per_cell
+                .validate()
+                .map_err(|e| c.err("ghost.one_point_per_cell", e.value.clone(), e.allowed.clone()))?;
+        }
         if !(self.report_file.ends_with(".md") && ident_ok(self.report_file.trim_end_matches(".md"))) {
             return Err(c.err(
                 "report_file",
@@ -864,6 +881,10 @@ impl StudySpec {
             points_per_cell: ppc,
             load_steps: plan.load_steps,
             newton: plan.newton,
+            ghost: match (ppc, self.ghost) {
+                (1, Some(g)) => g.one_point_per_cell,
+                _ => crate::ghost::GhostSettings::default(),
+            },
             ..ColumnSpec::default()
         }
     }
