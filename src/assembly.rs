@@ -187,12 +187,13 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             lin.oob[dof] += k * (u[col] - lin.u_t[col]);
         }
         if let Some(g) = self.ghost {
-            let diff: Vec<f64> = u.iter().zip(&lin.u_t).map(|(a, b)| a - b).collect();
+            // u − u_t, expanded to the nodes; scratch_eq then takes the (unused) free rows.
+            lin.scratch_eq.clear();
+            lin.scratch_eq.extend(u.iter().zip(&lin.u_t).map(|(a, b)| a - b));
             lin.scratch_nodal.clear();
             lin.scratch_nodal.resize(self.dofs.num_dofs(), 0.0);
-            self.dofs.expand(&diff, &mut lin.scratch_nodal);
-            lin.scratch_eq.clear();
-            lin.scratch_eq.resize(u.len(), 0.0);
+            self.dofs.expand(&lin.scratch_eq, &mut lin.scratch_nodal);
+            lin.scratch_eq.fill(0.0);
             g.add_residual(
                 self.dofs,
                 &lin.scratch_nodal,

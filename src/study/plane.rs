@@ -286,7 +286,8 @@ struct StoredCase<R> {
     seconds: f64,
 }
 
-/// [`run_cases`] with the case store: with `resume`, a case stored earlier under the same id
+/// [`run_cases`] with the case store (`--merge`: every case must be read from it, the ids of
+/// those that are not are returned in one error): with `resume`, a case stored earlier under the same id
 /// and input hash (`key` gives both, and whether the case has VTK output; with `--vtk`, its
 /// `.pvd` must exist too) is read back
 /// instead of solved; every solved case is stored as soon as it is done, and `vtk` (if on)
@@ -308,22 +309,8 @@ pub fn run_cases_stored<C: Sync, R: Send + Serialize + DeserializeOwned>(
         None => None,
     };
     let distribution = options.distribution;
-    if let (Distribution::Merge, Some(store), Some(dir)) = (distribution, &store, &options.study_dir) {
-        let missing: Vec<String> = cases
-            .iter()
-            .map(&key)
-            .filter(|(id, hash, _)| store.load::<StoredCase<R>>(id, hash).is_none())
-            .map(|(id, _, _)| id)
-            .collect();
-        if !missing.is_empty() {
-            return Err(StudyError::MissingCases {
-                dir: dir.join("cases").display().to_string(),
-                total: cases.len(),
-                missing,
-            });
-        }
-    }
-    let resume = options.resume || distribution == Distribution::Merge;
+    let merge = distribution == Distribution::Merge;
+    let resume = options.resume || merge;
     let own: Vec<&C> = cases
         .iter()
         .enumerate()
@@ -340,18 +327,22 @@ pub fn run_cases_stored<C: Sync, R: Send + Serialize + DeserializeOwned>(
             let (Some(store), Some(dir)) = (&store, &options.study_dir) else {
                 let r = solve(c);
                 (options.on_done)(&id, status(&r));
-                return Ok((r, None));
+                return Ok(Some((r, None)));
             };
+            // --merge solves nothing, so it does not ask for the VTK files either.
             let vtk_done = match options.vtk {
-                Some(_) if has_vtk => super::vtk_output::pvd_path(dir, &id)?.exists(),
+                Some(_) if has_vtk && !merge => super::vtk_output::pvd_path(dir, &id)?.exists(),
                 _ => true,
             };
             if resume && vtk_done {
                 if let Some(s) = store.load::<StoredCase<R>>(&id, &hash) {
                     resumed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                     (options.on_done)(&id, status(&s.output));
-                    return Ok((s.output, Some(s.seconds)));
+                    return Ok(Some((s.output, Some(s.seconds))));
                 }
+            }
+            if merge {
+                return Ok(None);
             }
             let t = Instant::now();
             let r = solve(c);
@@ -362,13 +353,23 @@ pub fn run_cases_stored<C: Sync, R: Send + Serialize + DeserializeOwned>(
             let stored = StoredCase { output: r, seconds };
             store.save(&id, &hash, &stored)?;
             (options.on_done)(&id, status(&stored.output));
-            Ok((stored.output, Some(seconds)))
+            Ok(Some((stored.output, Some(seconds))))
         },
     );
     let mut out = Vec::with_capacity(outputs.len());
-    for (r, secs) in outputs {
-        let (r, stored_secs) = r?;
-        out.push((r, stored_secs.unwrap_or(secs)));
+    let mut missing = vec![];
+    for (c, (r, secs)) in own.iter().zip(outputs) {
+        match r? {
+            Some((r, stored_secs)) => out.push((r, stored_secs.unwrap_or(secs))),
+            None => missing.push(key(c).0),
+        }
+    }
+    if let (false, Some(dir)) = (missing.is_empty(), &options.study_dir) {
+        return Err(StudyError::MissingCases {
+            dir: dir.join("cases").display().to_string(),
+            total: cases.len(),
+            missing,
+        });
     }
     if let (Distribution::Shard { k, n }, Some(dir)) = (distribution, &options.study_dir) {
         return Err(StudyError::ShardDone {
