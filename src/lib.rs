@@ -47,6 +47,7 @@ pub mod grid;
 pub mod kinematics;
 pub mod linear;
 pub mod load_stepping;
+pub mod method;
 pub mod mpm;
 pub mod newton;
 pub mod norms;

@@ -15,6 +15,7 @@ use crate::ghost::{GhostFaces, GhostSettings};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
 use crate::load_stepping::{LoadStepping, StepReport};
+use crate::method::Method;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, VolumeUpdate, WeakNodeTreatment};
 use crate::newton::NewtonSettings;
 use crate::particles::MaterialPoints;
@@ -357,4 +358,47 @@ pub fn solve_fem_q8(spec: &CantileverSpec) -> Result<FemOutcome, InputError> {
         }
     }
     Ok(out)
+}
+
+/// The methods that solve the cantilever.
+pub const METHODS: [Method; 2] = [Method::Igimp, Method::FemQ8];
+
+/// One cantilever analysis, whatever the method.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CantileverSolution {
+    pub steps: Vec<StepReport>,
+    pub end: Vec<EndDisplacement>,
+    pub failure: Option<SolveError>,
+    /// iGIMP only: snapshots, the smallest half-length after each step, the loaded points.
+    pub snapshots: Vec<DomainSnapshot>,
+    pub min_half_length: Vec<f64>,
+    pub loaded_points: Option<[usize; 2]>,
+}
+
+/// Solve the cantilever by `method`: iGIMP ([`solve_mpm`], snapshots every
+/// `snapshot_every` steps) or Q8 FEM ([`solve_fem_q8`]).
+pub fn solve(
+    spec: &CantileverSpec,
+    method: Method,
+    snapshot_every: usize,
+) -> Result<CantileverSolution, InputError> {
+    match method {
+        Method::Igimp => solve_mpm(spec, snapshot_every).map(|o| CantileverSolution {
+            steps: o.steps,
+            end: o.end,
+            failure: o.failure,
+            snapshots: o.snapshots,
+            min_half_length: o.min_half_length,
+            loaded_points: Some(o.loaded_points),
+        }),
+        Method::FemQ8 => solve_fem_q8(spec).map(|o| CantileverSolution {
+            steps: o.steps,
+            end: o.end,
+            failure: o.failure,
+            snapshots: vec![],
+            min_half_length: vec![],
+            loaded_points: None,
+        }),
+        _ => Err(method.unsupported("cantilever", &METHODS)),
+    }
 }

@@ -247,30 +247,15 @@ pub fn f_from_cauchy_stress(s: f64) -> f64 {
     y.exp()
 }
 
-/// Discretisation method of a column case.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Method {
-    /// Standard implicit MPM.
-    Mpm,
-    /// Implicit GIMP (the paper's method).
-    Igimp,
-    /// Updated-Lagrangian FEM, two-noded linear elements (2 Gauss points by default).
-    FemLinear,
-    /// Updated-Lagrangian FEM, three-noded quadratic elements (3 Gauss points by default).
-    FemQuadratic,
-}
+pub use crate::method::Method;
 
-impl Method {
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Mpm => "mpm",
-            Method::Igimp => "igimp",
-            Method::FemLinear => "fem-linear",
-            Method::FemQuadratic => "fem-quadratic",
-        }
-    }
-}
+/// The methods that solve the column.
+pub const METHODS: [Method; 4] = [
+    Method::Mpm,
+    Method::Igimp,
+    Method::FemLinear,
+    Method::FemQuadratic,
+];
 
 /// The column problem's parameters (defaults: §5.1 with W = 40,000).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -539,6 +524,7 @@ pub fn solve_column_observed(
         Method::Igimp => solve_mpm_observed(spec, Basis::Gimp, observer),
         Method::FemLinear => solve_fem_observed(spec, LineElement::Linear, observer),
         Method::FemQuadratic => solve_fem_observed(spec, LineElement::Quadratic, observer),
+        Method::FemQ4 | Method::FemQ8 => Err(method.unsupported("column", &METHODS)),
     }
 }
 

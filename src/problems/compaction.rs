@@ -15,6 +15,7 @@ use crate::ghost::{GhostFaces, GhostSettings};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
 use crate::load_stepping::{LoadStepping, StepReport};
+use crate::method::Method;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, WeakNodeTreatment};
 use crate::newton::NewtonSettings;
 use crate::particles::MaterialPoints;
@@ -282,5 +283,61 @@ pub fn solve_fem(spec: &CompactionSpec, element: QuadElement) -> Result<FemOutco
         failure,
         max_horizontal_displacement: fem.displacement(corner)[0],
         elements,
+    })
+}
+
+/// The methods that solve the compaction.
+pub const METHODS: [Method; 4] = [Method::Igimp, Method::Mpm, Method::FemQ4, Method::FemQ8];
+
+/// One compaction analysis, whatever the method.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompactionSolution {
+    pub steps: Vec<StepReport>,
+    pub failure: Option<SolveError>,
+    /// The measure of Figure 17 ([`CompactionOutcome`], [`FemOutcome`]).
+    pub max_horizontal_displacement: f64,
+    /// Weak-node constraints applied over all steps (0 for FEM).
+    pub weak_nodes_treated: usize,
+    /// Material points (MPM, iGIMP) or elements (FEM).
+    pub size: usize,
+    /// Final material point domains (none for FEM).
+    pub domains: Vec<DomainRecord>,
+}
+
+/// Solve the compaction by `method`: iGIMP or MPM weights on the material points (the
+/// method sets `spec.basis`), or Q4/Q8 FEM ([`solve_fem`]).
+pub fn solve(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution, InputError> {
+    let basis = match method {
+        Method::Igimp => Basis::Gimp,
+        Method::Mpm => Basis::Mpm,
+        Method::FemQ4 | Method::FemQ8 => {
+            let element = if method == Method::FemQ4 {
+                QuadElement::Q4
+            } else {
+                QuadElement::Q8
+            };
+            let o = solve_fem(spec, element)?;
+            return Ok(CompactionSolution {
+                steps: o.steps,
+                failure: o.failure,
+                max_horizontal_displacement: o.max_horizontal_displacement,
+                weak_nodes_treated: 0,
+                size: o.elements,
+                domains: vec![],
+            });
+        }
+        Method::FemLinear | Method::FemQuadratic => return Err(method.unsupported("compaction", &METHODS)),
+    };
+    let o = solve_mpm(&CompactionSpec {
+        basis,
+        ..spec.clone()
+    })?;
+    Ok(CompactionSolution {
+        size: o.points.len(),
+        steps: o.steps,
+        failure: o.failure,
+        max_horizontal_displacement: o.max_horizontal_displacement,
+        weak_nodes_treated: o.weak_nodes_treated,
+        domains: o.points,
     })
 }

@@ -9,28 +9,14 @@ use crate::study::results::AnalyticalRecord;
 use crate::study::runner::{
     points_file, read_points_csv, read_results, CaseRecord, CaseStatus, StudyResults,
 };
-use crate::study::{uses_material_points, weight_label, FigureKind, FigureSpec, Measure, StudyError};
+use crate::study::{weight_label, FigureKind, FigureSpec, Measure, StudyError};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Human name of a method, as in the paper.
-pub fn method_label(m: Method) -> &'static str {
-    match m {
-        Method::Mpm => "MPM",
-        Method::Igimp => "iGIMP",
-        Method::FemLinear => "linear FEM",
-        Method::FemQuadratic => "quadratic FEM",
-    }
-}
-
 fn series_label(m: Method, ppc: Option<usize>) -> String {
     match ppc {
-        Some(p) => format!(
-            "{}, {p} point{}/cell",
-            method_label(m),
-            if p == 1 { "" } else { "s" }
-        ),
-        None => method_label(m).to_string(),
+        Some(p) => format!("{}, {p} point{}/cell", m.label(), if p == 1 { "" } else { "s" }),
+        None => m.label().to_string(),
     }
 }
 
@@ -71,7 +57,7 @@ fn sweep_series(results: &StudyResults, sweep_id: &str, load: f64) -> Vec<(Metho
     }
     let mut out = vec![];
     for &m in &plan.methods {
-        if uses_material_points(m) {
+        if m.uses_material_points() {
             out.extend(plan.points_per_cell.iter().map(|&p| (m, Some(p))));
         } else {
             out.push((m, None));
@@ -141,7 +127,7 @@ pub fn report_markdown(results: &StudyResults) -> String {
             s,
             "## {}: {}, W = {}{}\n",
             p.table,
-            method_label(p.method),
+            Method::label(p.method),
             weight_label(p.weight),
             ppc.map_or(String::new(), |n| format!(", {n} points per cell"))
         );
@@ -403,8 +389,8 @@ pub fn report_markdown(results: &StudyResults) -> String {
                 c.sweep,
                 weight_label(c.load),
                 c.measure.name(),
-                method_label(c.lower),
-                method_label(c.higher),
+                Method::label(c.lower),
+                Method::label(c.higher),
                 if c.elements_checked.is_empty() {
                     "—".to_string()
                 } else {

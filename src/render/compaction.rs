@@ -1,11 +1,12 @@
 //! Rendering of the compaction study (§5.2): the report, Tables 2–3 and Figures 15–18 from
 //! `results.json` and `domains.json` only.
 
+use crate::method::Method;
 use crate::newton::ResidualNorm;
 use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, XyAxes, XySeries};
 use crate::problems::compaction::DomainRecord;
 use crate::study::compaction::*;
-use crate::study::plane::{self, IndexEntry, PlaneMethod};
+use crate::study::plane::{self, IndexEntry};
 use crate::study::runner::CaseStatus;
 use crate::study::StudyError;
 use std::collections::{BTreeMap, BTreeSet};
@@ -90,7 +91,7 @@ fn figure17_table(results: &CompactionResults) -> String {
     hs.sort_by(|a, b| b.total_cmp(a));
     hs.dedup();
     let ppcs: BTreeSet<usize> = cases.iter().filter_map(|c| c.points_per_cell).collect();
-    let fems: BTreeSet<PlaneMethod> = cases.iter().map(|c| c.method).filter(|m| m.is_fem()).collect();
+    let fems: BTreeSet<Method> = cases.iter().map(|c| c.method).filter(|m| m.is_fem()).collect();
     let reference = results.reference.as_ref();
     let mut s = format!(
         "## Figure 17: maximum horizontal displacement\n\nBottom-right material point's horizontal displacement plus half the growth of its domain \
@@ -376,7 +377,7 @@ fn render_figure(
             };
             // The full description is in the report; the title only names the reference.
             let short = match (reference.method, reference.observed_order) {
-                (PlaneMethod::Igimp, _) => "finest iGIMP (no FEM)".to_string(),
+                (Method::Igimp, _) => "finest iGIMP (no FEM)".to_string(),
                 (m, Some(_)) => format!("{}, extrapolated", m.label()),
                 (m, None) => format!("finest {}", m.label()),
             };
@@ -387,7 +388,7 @@ fn render_figure(
 }
 
 /// A Figure 17 series: method and points per cell.
-type SeriesKey = (PlaneMethod, Option<usize>);
+type SeriesKey = (Method, Option<usize>);
 
 /// Render the report, the residual tables and the figures from `dir`'s `results.json` and
 /// `domains.json`. Returns the files written.

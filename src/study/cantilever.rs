@@ -14,15 +14,14 @@
 
 use super::plane::{
     self, check_at_most, failure_record, invalid, rejection, step_records, CheckRecord, GhostSection,
-    PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
+    PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
 };
 use super::runner::{CaseStatus, FailureRecord, StepRecord};
 use super::vtk_output::{write_domain_frames, DomainFrame};
 use super::{NewtonSection, StudyError, Tier};
-use crate::error::SolveError;
-use crate::load_stepping::StepReport;
+use crate::method::Method;
 use crate::mpm::{DomainUpdate, VolumeUpdate};
-use crate::problems::cantilever::{solve_fem_q8, solve_mpm, CantileverSpec, DomainSnapshot, EndDisplacement};
+use crate::problems::cantilever::{solve, CantileverSpec, DomainSnapshot, EndDisplacement, METHODS};
 use crate::problems::elastica::{bending_stiffness, Elastica};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
@@ -53,7 +52,7 @@ pub struct BeamSection {
 pub struct CaseSection {
     pub id: String,
     pub title: String,
-    pub method: PlaneMethod,
+    pub method: Method,
     /// iGIMP domain update: `stretch` (eq 39, the default) or `f-diagonal` (eq 37).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub domain_update: Option<DomainUpdate>,
@@ -188,7 +187,7 @@ pub struct CantileverStudy {
 #[derive(Debug, Clone, PartialEq)]
 pub struct CantileverCase {
     pub id: String,
-    pub method: PlaneMethod,
+    pub method: Method,
     pub spec: CantileverSpec,
     pub snapshot_every: usize,
 }
@@ -233,14 +232,9 @@ impl PlaneStudy for CantileverStudy {
                     format!("must be a unique identifier ({})", super::IDENT_RULE),
                 ));
             }
-            if c.method == PlaneMethod::FemQ4 {
-                return Err(invalid(
-                    file,
-                    format!("cases[{i}].method"),
-                    "fem-q4",
-                    "must be igimp or fem-q8",
-                ));
-            }
+            c.method
+                .expect_one_of("cantilever", &METHODS)
+                .map_err(|e| invalid(file, format!("cases[{i}].method"), c.method.name(), e.allowed))?;
             if !(0..=10_000).contains(&c.snapshot_every) {
                 return Err(invalid(
                     file,
@@ -482,7 +476,7 @@ fn elastica_path(spec: &CantileverSpec, plane_strain: bool) -> Option<ElasticaPa
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CantileverRecord {
     pub id: String,
-    pub method: PlaneMethod,
+    pub method: Method,
     pub domain_update: Option<DomainUpdate>,
     pub volume_update: Option<VolumeUpdate>,
     pub depth: f64,
@@ -564,23 +558,13 @@ impl CantileverRun {
     }
 }
 
-/// What a solver returns for one cantilever case (iGIMP or FEM).
-struct CaseOutcome {
-    steps: Vec<StepReport>,
-    end: Vec<EndDisplacement>,
-    failure: Option<SolveError>,
-    snapshots: Vec<DomainSnapshot>,
-    min_half_length: Vec<f64>,
-    loaded_points: Option<[usize; 2]>,
-}
-
 /// Solve one case, taking domain snapshots every `snapshot_every` steps (0: none).
 fn solve_case_snapshots(
     case: &CantileverCase,
     snapshot_every: usize,
 ) -> (CantileverRecord, Vec<DomainSnapshot>) {
     let s = &case.spec;
-    let igimp = case.method == PlaneMethod::Igimp;
+    let igimp = case.method == Method::Igimp;
     let mut rec = CantileverRecord {
         id: case.id.clone(),
         method: case.method,
@@ -604,30 +588,10 @@ fn solve_case_snapshots(
         newton_iterations: 0,
         steps: vec![],
     };
-    let outcome = match case.method {
-        PlaneMethod::Igimp => solve_mpm(s, snapshot_every)
-            .map_err(|e| e.to_string())
-            .map(|o| CaseOutcome {
-                steps: o.steps,
-                end: o.end,
-                failure: o.failure,
-                snapshots: o.snapshots,
-                min_half_length: o.min_half_length,
-                loaded_points: Some(o.loaded_points),
-            }),
-        PlaneMethod::FemQ8 => solve_fem_q8(s).map_err(|e| e.to_string()).map(|o| CaseOutcome {
-            steps: o.steps,
-            end: o.end,
-            failure: o.failure,
-            snapshots: vec![],
-            min_half_length: vec![],
-            loaded_points: None,
-        }),
-        PlaneMethod::FemQ4 => Err("the cantilever study uses Q8 elements (fem-q8)".to_string()),
-    };
+    let outcome = solve(s, case.method, snapshot_every);
     let o = match outcome {
-        Err(reason) => {
-            rec.failure = Some(rejection(reason));
+        Err(e) => {
+            rec.failure = Some(rejection(e.to_string()));
             return (rec, vec![]);
         }
         Ok(o) => o,

@@ -11,15 +11,13 @@
 
 use super::plane::{
     self, check_at_most, failure_record, invalid, rejection, step_records, CheckRecord, GhostSection,
-    PlaneMethod, PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
+    PlaneStudy, Provenance, RunSummary, Timing, WeakNodeSection,
 };
 use super::runner::{CaseStatus, FailureRecord, StepRecord};
 use super::vtk_output::{write_domain_frames, DomainFrame};
 use super::{NewtonSection, StudyError, Tier};
-use crate::error::SolveError;
-use crate::fem::QuadElement;
-use crate::load_stepping::StepReport;
-use crate::problems::compaction::{solve_fem, solve_mpm, CompactionSpec, DomainRecord};
+use crate::method::Method;
+use crate::problems::compaction::{solve, CompactionSpec, DomainRecord, METHODS};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -48,7 +46,7 @@ pub struct SweepQuick {
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub skip: bool,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub methods: Option<Vec<PlaneMethod>>,
+    pub methods: Option<Vec<Method>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub element_sizes: Option<Vec<f64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -65,7 +63,7 @@ pub struct SweepQuick {
 pub struct CompactionSweep {
     pub id: String,
     pub title: String,
-    pub methods: Vec<PlaneMethod>,
+    pub methods: Vec<Method>,
     /// Von Mises yield stress ρ_y; absent: linear elastic.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub yield_stress: Option<f64>,
@@ -221,7 +219,7 @@ pub struct CompactionStudy {
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompactionCase {
     pub id: String,
-    pub method: PlaneMethod,
+    pub method: Method,
     pub spec: CompactionSpec,
 }
 
@@ -302,6 +300,10 @@ impl PlaneStudy for CompactionStudy {
                             super::MAX_POINTS_PER_CELL
                         ),
                     ));
+                }
+                for (j, m) in plan.methods.iter().enumerate() {
+                    m.expect_one_of("compaction", &METHODS)
+                        .map_err(|e| invalid(file, k(&format!("methods[{j}]")), m.name(), e.allowed))?;
                 }
                 for c in self.sweep_cases(s, &plan) {
                     c.spec.validate().map_err(|e| {
@@ -441,7 +443,7 @@ impl CompactionStudy {
         }
     }
 
-    fn case_id(&self, method: PlaneMethod, spec: &CompactionSpec) -> String {
+    fn case_id(&self, method: Method, spec: &CompactionSpec) -> String {
         let material = match spec.yield_stress {
             None => "elastic".to_string(),
             Some(y) => format!("vm{}", number(y)),
@@ -510,7 +512,7 @@ impl CompactionStudy {
 
 #[derive(Debug, Clone, PartialEq)]
 struct SweepPlan {
-    methods: Vec<PlaneMethod>,
+    methods: Vec<Method>,
     element_sizes: Vec<f64>,
     points_per_cell: Vec<i64>,
     tolerances: Vec<f64>,
@@ -521,7 +523,7 @@ struct SweepPlan {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CompactionRecord {
     pub id: String,
-    pub method: PlaneMethod,
+    pub method: Method,
     /// Element size h.
     pub h: f64,
     /// Points per element along each axis; `None` (null) for FEM.
@@ -554,7 +556,7 @@ pub struct CompactionRecord {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ReferenceRecord {
     pub value: f64,
-    pub method: PlaneMethod,
+    pub method: Method,
     /// The case(s) it comes from.
     pub cases: Vec<String>,
     /// Observed convergence order when Richardson-extrapolated.
@@ -598,7 +600,7 @@ impl CompactionResults {
     /// The iGIMP case of a sweep at (h, points per cell) with the study's weak-node tolerance.
     pub fn igimp_case(&self, sweep: &str, h: f64, ppc: usize) -> Option<&CompactionRecord> {
         self.sweep(sweep).into_iter().find(|c| {
-            c.method == PlaneMethod::Igimp && c.h == h && c.points_per_cell == Some(ppc) && self.is_default(c)
+            c.method == Method::Igimp && c.h == h && c.points_per_cell == Some(ppc) && self.is_default(c)
         })
     }
 
@@ -630,16 +632,6 @@ impl CompactionRun {
     }
 }
 
-/// What a solver returns for one compaction case (iGIMP or FEM).
-struct CaseOutcome {
-    steps: Vec<StepReport>,
-    failure: Option<SolveError>,
-    max_horizontal_displacement: f64,
-    weak_nodes_treated: usize,
-    points: usize,
-    domains: Vec<DomainRecord>,
-}
-
 fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
     let s = &case.spec;
     let mut rec = CompactionRecord {
@@ -662,36 +654,10 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
         newton_iterations: 0,
         steps: vec![],
     };
-    let outcome = match case.method {
-        PlaneMethod::Igimp => solve_mpm(s).map_err(|e| e.to_string()).map(|o| CaseOutcome {
-            points: o.points.len(),
-            steps: o.steps,
-            failure: o.failure,
-            max_horizontal_displacement: o.max_horizontal_displacement,
-            weak_nodes_treated: o.weak_nodes_treated,
-            domains: o.points,
-        }),
-        PlaneMethod::FemQ4 | PlaneMethod::FemQ8 => {
-            let element = if case.method == PlaneMethod::FemQ4 {
-                QuadElement::Q4
-            } else {
-                QuadElement::Q8
-            };
-            solve_fem(s, element)
-                .map_err(|e| e.to_string())
-                .map(|o| CaseOutcome {
-                    steps: o.steps,
-                    failure: o.failure,
-                    max_horizontal_displacement: o.max_horizontal_displacement,
-                    weak_nodes_treated: 0,
-                    points: o.elements,
-                    domains: vec![],
-                })
-        }
-    };
+    let outcome = solve(s, case.method);
     match outcome {
-        Err(reason) => {
-            rec.failure = Some(rejection(reason));
+        Err(e) => {
+            rec.failure = Some(rejection(e.to_string()));
             (rec, vec![])
         }
         Ok(o) => {
@@ -700,7 +666,7 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
             rec.weak_nodes_treated = o.weak_nodes_treated;
             rec.steps_cut = o.steps.iter().filter(|s| s.cutbacks() > 0).count();
             rec.cutbacks = o.steps.iter().map(|s| s.cutbacks()).sum();
-            rec.points = o.points;
+            rec.points = o.size;
             let u = o
                 .max_horizontal_displacement
                 .is_finite()
@@ -774,14 +740,14 @@ fn figure17_reference(results: &CompactionResults) -> Option<ReferenceRecord> {
     let finest = results
         .sweep(&results.study.reference.igimp_sweep)
         .into_iter()
-        .filter(|c| c.method == PlaneMethod::Igimp && c.max_horizontal_displacement.is_some())
+        .filter(|c| c.method == Method::Igimp && c.max_horizontal_displacement.is_some())
         .min_by(|a, b| {
             a.h.total_cmp(&b.h)
                 .then(b.points_per_cell.cmp(&a.points_per_cell))
         })?;
     Some(ReferenceRecord {
         value: finest.max_horizontal_displacement?,
-        method: PlaneMethod::Igimp,
+        method: Method::Igimp,
         cases: vec![finest.id.clone()],
         observed_order: None,
         description: format!(
@@ -800,7 +766,7 @@ fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
         results
             .sweep(sweep)
             .into_iter()
-            .filter(|c| c.method == PlaneMethod::Igimp && c.max_horizontal_displacement.is_some())
+            .filter(|c| c.method == Method::Igimp && c.max_horizontal_displacement.is_some())
             .collect()
     };
     let deviation = |c: &CompactionRecord| -> Option<f64> {
@@ -1024,7 +990,7 @@ pub fn run_study_with(
                 study.weak_nodes.tolerance,
                 None,
             );
-            Some(study.case_id(PlaneMethod::Igimp, &spec))
+            Some(study.case_id(Method::Igimp, &spec))
         })
         .collect();
     let mut records = vec![];

@@ -397,11 +397,6 @@ pub struct ColumnGhost {
     pub one_point_per_cell: crate::ghost::GhostSettings,
 }
 
-/// True for the methods whose points per cell matter.
-pub fn uses_material_points(method: Method) -> bool {
-    matches!(method, Method::Mpm | Method::Igimp)
-}
-
 /// One case to solve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Case {
@@ -717,6 +712,8 @@ impl StudySpec {
         let k = |f: &str| format!("{prefix}{f}");
         c.non_empty(&k("methods"), methods)?;
         for (j, m) in methods.iter().enumerate() {
+            m.expect_one_of("column", &crate::problems::column::METHODS)
+                .map_err(|e| c.err(format!("{}[{j}]", k("methods")), m.name(), e.allowed))?;
             if methods[..j].contains(m) {
                 return Err(c.err(
                     format!("{}[{j}]", k("methods")),
@@ -752,7 +749,7 @@ impl StudySpec {
             )?;
         }
         let max_ppc = ppc.iter().copied().max().unwrap_or(1);
-        if methods.iter().any(|&m| uses_material_points(m)) {
+        if methods.iter().any(|&m| m.uses_material_points()) {
             for (j, &n) in elements.iter().enumerate() {
                 if n * max_ppc > MAX_POINTS_PER_CASE {
                     return Err(c.err(
@@ -811,7 +808,7 @@ impl StudySpec {
                 format!("must be a weight of sweep `{}`", sweep.id),
             ));
         }
-        match (uses_material_points(method), ppc) {
+        match (method.uses_material_points(), ppc) {
             (true, None) => Err(c.err(
                 k("points_per_cell"),
                 "(missing)",
@@ -915,7 +912,7 @@ impl StudySpec {
     pub fn sweep_cases(&self, plan: &SweepPlan) -> Vec<Case> {
         let mut out = Vec::new();
         for &method in &plan.methods {
-            let ppcs: Vec<Option<usize>> = if uses_material_points(method) {
+            let ppcs: Vec<Option<usize>> = if method.uses_material_points() {
                 plan.points_per_cell.iter().map(|&p| Some(p)).collect()
             } else {
                 vec![None]

@@ -17,6 +17,7 @@ use super::runner::{CaseStatus, FailureRecord, Software, StepRecord};
 use super::{StudyError, Tier};
 use crate::error::SolveError;
 use crate::load_stepping::StepReport;
+use crate::method::Method;
 use crate::mpm::WeakNodeTreatment;
 use rayon::prelude::*;
 use serde::de::DeserializeOwned;
@@ -25,38 +26,6 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// Method of a plane-strain case.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum PlaneMethod {
-    /// Implicit GIMP (the paper's method).
-    Igimp,
-    /// Updated-Lagrangian FEM, 4-node quadrilaterals, 2×2 Gauss points (Figure 17 reference).
-    FemQ4,
-    /// Updated-Lagrangian FEM, 8-node quadrilaterals, 3×3 Gauss points (Figure 21).
-    FemQ8,
-}
-
-impl PlaneMethod {
-    pub fn name(self) -> &'static str {
-        match self {
-            PlaneMethod::Igimp => "igimp",
-            PlaneMethod::FemQ4 => "fem-q4",
-            PlaneMethod::FemQ8 => "fem-q8",
-        }
-    }
-    pub fn label(self) -> &'static str {
-        match self {
-            PlaneMethod::Igimp => "iGIMP",
-            PlaneMethod::FemQ4 => "Q4 FEM",
-            PlaneMethod::FemQ8 => "Q8 FEM",
-        }
-    }
-    pub fn is_fem(self) -> bool {
-        !matches!(self, PlaneMethod::Igimp)
-    }
-}
 
 /// Weak-node treatment as written in a study file (see [`crate::mpm::MpmSettings`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -251,7 +220,7 @@ impl Default for PlaneRunOptions<'_> {
 #[derive(Serialize)]
 struct CaseDefinition<'a, S> {
     id: &'a str,
-    method: PlaneMethod,
+    method: Method,
     spec: &'a S,
     /// Domain snapshots taken for the figures (0: none).
     snapshot_every: usize,
@@ -261,7 +230,7 @@ struct CaseDefinition<'a, S> {
 /// whether it has VTK output (iGIMP cases).
 pub fn case_key<S: Serialize>(
     id: &str,
-    method: PlaneMethod,
+    method: Method,
     spec: &S,
     snapshot_every: usize,
 ) -> (String, String, bool) {
@@ -274,7 +243,7 @@ pub fn case_key<S: Serialize>(
     (
         id.to_string(),
         super::store::case_hash(&def),
-        method == PlaneMethod::Igimp,
+        method.uses_material_points(),
     )
 }
 

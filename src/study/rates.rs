@@ -7,7 +7,7 @@
 
 pub use super::results::{CaseIndex, ComparisonRecord, ExpectedBand, RateRecord};
 use super::results::{CaseRecord, CaseStatus};
-use super::{uses_material_points, Measure, StudySpec, Tier};
+use super::{Measure, StudySpec, Tier};
 use crate::norms::fitted_rate;
 use crate::problems::column::Method;
 
@@ -74,7 +74,7 @@ pub fn compute_rates(
         }
         let ids = case_ids.of_sweep(&sweep.id);
         for &method in &plan.methods {
-            let ppcs: Vec<Option<usize>> = if uses_material_points(method) {
+            let ppcs: Vec<Option<usize>> = if method.uses_material_points() {
                 plan.points_per_cell.iter().map(|&p| Some(p)).collect()
             } else {
                 vec![None]
@@ -164,7 +164,7 @@ pub fn compute_comparisons(
             if let Some(plan) = spec.plan(sweep, tier) {
                 let ids = case_ids.of_sweep(&sweep.id);
                 let pick = |m: Method| -> Vec<&CaseRecord> {
-                    let ppcs: Vec<Option<usize>> = if uses_material_points(m) {
+                    let ppcs: Vec<Option<usize>> = if m.uses_material_points() {
                         plan.points_per_cell.iter().map(|&p| Some(p)).collect()
                     } else {
                         vec![None]

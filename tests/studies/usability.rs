@@ -417,7 +417,7 @@ fn plane_studies_resume_and_write_vtk() {
     for c in a
         .cases
         .iter()
-        .filter(|c| c.method == igimp::study::plane::PlaneMethod::Igimp)
+        .filter(|c| c.method == igimp::method::Method::Igimp)
     {
         assert!(
             tmp.path()

@@ -231,3 +231,24 @@ fn bad_compaction_input_names_the_field() {
         assert!(e.field.contains(field), "expected {field}: {e}");
     }
 }
+
+/// Plain MPM weights on the same points (Method::Mpm; the problem sets the basis) converge
+/// and agree with iGIMP: at h = 1, 2×2 points, max horizontal u 0.586795 against 0.592824
+/// (1.0 %, measured 2026-12-01; 0.86 % at h = 0.5). Band 2 %: the two weightings differ by
+/// the GIMP smoothing only, which is O(h) here. A method the problem has no solution for is
+/// an input error naming `method` and the methods it has.
+#[test]
+fn mpm_weights_solve_the_compaction_and_other_methods_are_named_errors() {
+    use igimp::method::Method;
+    use igimp::problems::compaction::solve;
+    let spec = CompactionSpec::default();
+    let mpm = solve(&spec, Method::Mpm).unwrap();
+    let gimp = solve(&spec, Method::Igimp).unwrap();
+    assert!(mpm.failure.is_none() && gimp.failure.is_none());
+    let dev = (mpm.max_horizontal_displacement / gimp.max_horizontal_displacement - 1.0).abs();
+    assert!(dev < 0.02, "MPM vs iGIMP: {dev:.4}");
+    assert!(dev > 1e-4, "MPM must not be the iGIMP run: {dev:.2e}");
+    let e = solve(&spec, Method::FemLinear).unwrap_err();
+    assert_eq!(e.field, "method");
+    assert!(e.allowed.contains("igimp, mpm, fem-q4, fem-q8"), "{e}");
+}
