@@ -328,10 +328,7 @@ pub fn solve(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution
         }
         Method::FemLinear | Method::FemQuadratic => return Err(method.unsupported("compaction", &METHODS)),
     };
-    let o = solve_mpm(&CompactionSpec {
-        basis,
-        ..spec.clone()
-    })?;
+    let o = solve_mpm(&CompactionSpec { basis, ..*spec })?;
     Ok(CompactionSolution {
         size: o.points.len(),
         steps: o.steps,
