@@ -44,6 +44,7 @@ pub mod error;
 pub mod fem;
 pub mod ghost;
 pub mod grid;
+pub mod kinds;
 pub mod kinematics;
 pub mod linear;
 pub mod load_stepping;

@@ -5,12 +5,12 @@
 //! SVG figures and `reports/index.md` from those files.
 
 use clap::{CommandFactory, FromArgMatches, Parser};
-use igimp::render::column as report;
-use igimp::study::runner::{
-    read_results, run_study_in, study_dir, write_outputs, CaseRecord, CaseStatus, RunOptions,
-};
+use igimp::kinds;
+use igimp::study::checks::{check_counts, CheckRecord};
+use igimp::study::engine::RunOptions;
+use igimp::study::results::{read_json, CaseStatus};
 use igimp::study::vtk_output::VtkOptions;
-use igimp::study::{plane, registry, study_files, Distribution, StudyError, StudySpec, Tier};
+use igimp::study::{study_files, Distribution, StudyError, Tier};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -95,13 +95,7 @@ fn default_studies_dir() -> PathBuf {
 /// (name, summary) of every valid study file in `dir`, and the errors of invalid ones.
 fn catalogue(dir: &Path) -> Vec<Result<(String, String), StudyError>> {
     match study_files(dir) {
-        Ok(files) => files
-            .iter()
-            .map(|f| {
-                registry::catalogue_entry(f)
-                    .unwrap_or_else(|| StudySpec::load(f).map(|s| (s.name, s.summary)))
-            })
-            .collect(),
+        Ok(files) => files.iter().map(|f| kinds::catalogue_entry(f)).collect(),
         Err(e) => vec![Err(e)],
     }
 }
@@ -147,18 +141,17 @@ fn progress(n: u64) -> ProgressBar {
     bar
 }
 
-/// Run a plane-strain study (compaction, cantilever); `None` if `file` is another study.
-fn run_plane(file: &Path, cli: &Cli) -> Result<Option<bool>, StudyError> {
-    let Ok(text) = std::fs::read_to_string(file) else {
-        return Ok(None);
-    };
-    let Some(problem) = plane::problem_of_study(&text).filter(|p| registry::is_plane_problem(p)) else {
-        return Ok(None);
-    };
+/// Solve (unless `--render-only`) and render one study file; `Ok(false)` if a check failed
+/// or could not be evaluated.
+fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
     let tier = if cli.quick { Tier::Quick } else { Tier::Full };
     let start = Instant::now();
+    let label = file.file_stem().map_or_else(
+        || file.display().to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
     let bar = progress(0);
-    bar.set_prefix(problem.clone());
+    bar.set_prefix(label.clone());
     let on_start = |n: usize| bar.set_length(n as u64);
     let on_done = |id: &str, status: CaseStatus| {
         if status != CaseStatus::Converged {
@@ -166,7 +159,7 @@ fn run_plane(file: &Path, cli: &Cli) -> Result<Option<bool>, StudyError> {
         }
         bar.inc(1);
     };
-    let options = plane::PlaneRunOptions {
+    let options = RunOptions {
         study_dir: None,
         resume: cli.resume,
         vtk: (cli.vtk || cli.vtk_every.is_some()).then(|| VtkOptions {
@@ -176,122 +169,50 @@ fn run_plane(file: &Path, cli: &Cli) -> Result<Option<bool>, StudyError> {
         on_start: &on_start,
         on_done: &on_done,
     };
-    let ran = registry::run_file(file, &text, &problem, tier, &cli.out, cli.render_only, options);
+    let ran = kinds::run_file(file, tier, &cli.out, cli.render_only, options);
     bar.finish_and_clear();
     if let Err(e @ StudyError::ShardDone { .. }) = &ran {
-        eprintln!("{problem}: {e}");
-        return Ok(Some(true));
+        eprintln!("{label}: {e}");
+        return Ok(true);
     }
     let (dir, summary, files) = ran?;
+    let name = dir
+        .file_name()
+        .map_or(label, |n| n.to_string_lossy().into_owned());
     if let Some(r) = summary.as_ref().filter(|_| cli.resume) {
         eprintln!(
-            "{problem}: resumed {} of {} cases from {}",
+            "{name}: resumed {} of {} cases from {}",
             r.resumed,
             r.cases,
             dir.join("cases").display()
         );
     }
-    if let Some(r) = summary {
-        eprintln!(
-            "{problem}: {} cases ({} failed, {} rejected) solved and {} files rendered into {} in {:.2} s",
+    match summary {
+        Some(r) => eprintln!(
+            "{name}: {} cases ({} failed, {} rejected) solved and {} files rendered into {} in {:.2} s on {} threads",
             r.cases,
             r.failed,
             r.rejected,
             files.len(),
             dir.display(),
-            start.elapsed().as_secs_f64()
-        );
-    }
-    let (pass, fail, none) = registry::folder_check_counts(&dir)?;
-    eprintln!("{problem}: checks: {pass} passed, {fail} failed, {none} not evaluated");
-    Ok(Some(fail == 0 && none == 0))
-}
-
-fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
-    if let Some(ok) = run_plane(file, cli)? {
-        return Ok(ok);
-    }
-    let spec = StudySpec::load(file)?;
-    let dir = study_dir(&cli.out, &spec.name);
-    if !cli.render_only {
-        let tier = if cli.quick { Tier::Quick } else { Tier::Full };
-        let n = spec.cases(tier).len() as u64;
-        let bar = progress(n);
-        bar.set_prefix(spec.name.clone());
-        let on_done = |c: &CaseRecord| {
-            if c.status != CaseStatus::Converged {
-                bar.set_message(format!("{} {:?}", c.id, c.status));
-            }
-            bar.inc(1);
-        };
-        let start = Instant::now();
-        let file_name = file.file_name().map_or_else(
-            || file.display().to_string(),
-            |f| f.to_string_lossy().into_owned(),
-        );
-        let options = RunOptions {
-            out: cli.out.clone(),
-            resume: cli.resume,
-            vtk: (cli.vtk || cli.vtk_every.is_some()).then(|| VtkOptions {
-                every: cli.vtk_every.map_or(0, |n| n as usize),
-            }),
-            distribution: cli.distribution(),
-        };
-        let run = run_study_in(&spec, &file_name, tier, &options, &on_done);
-        bar.finish_and_clear();
-        if let Err(e @ StudyError::ShardDone { .. }) = &run {
-            eprintln!("{}: {e}", spec.name);
-            return Ok(true);
-        }
-        let run = run?;
-        if cli.resume {
-            eprintln!(
-                "{}: resumed {} of {} cases from {}",
-                spec.name,
-                run.resumed,
-                run.results.cases.len(),
-                dir.join("cases").display()
-            );
-        }
-        write_outputs(&cli.out, &run)?;
-        let r = &run.results;
-        let failed = r.cases.iter().filter(|c| c.status == CaseStatus::Failed).count();
-        let rejected = r
-            .cases
-            .iter()
-            .filter(|c| c.status == CaseStatus::Rejected)
-            .count();
-        eprintln!(
-            "{}: {} cases ({} failed, {} rejected) solved in {:.2} s on {} threads",
-            spec.name,
-            r.cases.len(),
-            failed,
-            rejected,
             start.elapsed().as_secs_f64(),
-            r.timing.threads
-        );
+            rayon::current_num_threads()
+        ),
+        None => eprintln!("{name}: rendered {} files into {}", files.len(), dir.display()),
     }
-    let t = Instant::now();
-    let files = report::render_study(&dir)?;
-    let results = read_results(&dir)?;
-    let (pass, fail, none) = results.check_counts();
-    eprintln!(
-        "{}: rendered {} files into {} in {:.2} s; checks: {pass} passed, {fail} failed, {none} not evaluated",
-        spec.name,
-        files.len(),
-        dir.display(),
-        t.elapsed().as_secs_f64()
-    );
-    for r in results.rates.iter().filter(|r| r.pass == Some(false)) {
+    let checks: Vec<CheckRecord> = read_json::<serde_json::Value>(&dir.join("results.json"))
+        .ok()
+        .and_then(|v| serde_json::from_value(v.get("checks")?.clone()).ok())
+        .unwrap_or_default();
+    let (pass, fail, none) = check_counts(&checks);
+    eprintln!("{name}: checks: {pass} passed, {fail} failed, {none} not evaluated");
+    for c in checks.iter().filter(|c| c.pass != Some(true)) {
         eprintln!(
-            "  rate FAIL: {} {} W={} ppc={:?} {}: slope {:?}, expected {:?}",
-            r.sweep,
-            r.method.name(),
-            r.load,
-            r.points_per_cell,
-            r.measure.name(),
-            r.slope,
-            r.expected.as_ref().map(|b| (b.rate, b.tolerance))
+            "  check {}: {}: measured {}, limit {}",
+            if c.pass.is_none() { "not evaluated" } else { "FAIL" },
+            c.id,
+            c.measured.map_or("—".to_string(), |m| format!("{m:.4e}")),
+            c.limit
         );
     }
     Ok(fail == 0 && none == 0)
@@ -355,7 +276,7 @@ fn main() -> ExitCode {
             path: cli.out.display().to_string(),
             message: e.to_string(),
         })
-        .and_then(|_| report::render_index(&cli.out))
+        .and_then(|_| kinds::render_index(&cli.out))
     {
         eprintln!("error: {e}");
         return ExitCode::FAILURE;

@@ -4,8 +4,10 @@
 use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, PointMarks, XyAxes, XySeries};
 use crate::problems::cantilever::DomainSnapshot;
 use crate::study::cantilever::*;
-use crate::study::plane::{self, IndexEntry};
-use crate::study::runner::CaseStatus;
+type Results = CantileverResults;
+use super::{checks_markdown, failures_markdown, IndexEntry};
+use crate::study::checks::check_counts;
+use crate::study::results::{read_json, read_results, CaseStatus};
 use crate::study::StudyError;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -30,7 +32,7 @@ fn case_label(study: &CantileverStudy, r: &CantileverRecord) -> String {
 /// The main report.
 pub fn report_markdown(results: &CantileverResults) -> String {
     let study = &results.study;
-    let (pass, fail, none) = plane::check_counts(&results.checks);
+    let (pass, fail, none) = check_counts(&results.checks);
     let mut s = format!(
         "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated.\n\n",
         study.name,
@@ -49,7 +51,7 @@ pub fn report_markdown(results: &CantileverResults) -> String {
                 (Some(d), Some(v)) => format!("{d:?} / {v:?}"),
                 _ => "—".into(),
             },
-            plane::status_word(r.status),
+            r.status.word(),
             r.end.len(),
             r.load_steps,
             f5(r.u_over_l),
@@ -61,7 +63,7 @@ pub fn report_markdown(results: &CantileverResults) -> String {
         );
     }
     s.push('\n');
-    for p in &results.elastica {
+    for p in &results.measures.elastica {
         let _ = writeln!(
             s,
             "Elastica, plane {}: EI = {:.6e} N·m, α = PL²/EI = {:.4} at the full load.\n",
@@ -70,9 +72,9 @@ pub fn report_markdown(results: &CantileverResults) -> String {
             p.points.last().map_or(f64::NAN, |e| e.alpha)
         );
     }
-    if !results.depth_study.is_empty() {
+    if !results.measures.depth_study.is_empty() {
         s.push_str("## Depth study\n\nThe same PL²/EI (P ∝ depth³) and a fixed number of elements through the depth (h ∝ depth); the elastica is the same for every row.\n\n| case | elements through depth | depth | P | h | u/L | v/L | Δu | Δv |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-        for r in &results.depth_study {
+        for r in &results.measures.depth_study {
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
@@ -89,14 +91,14 @@ pub fn report_markdown(results: &CantileverResults) -> String {
         }
         s.push('\n');
     }
-    s.push_str(&plane::checks_markdown(&results.checks));
+    s.push_str(&checks_markdown(&results.checks));
     // Load path every 5 steps (Figure 21's data).
     let shown: Vec<&CantileverRecord> = results
         .cases
         .iter()
         .filter(|r| !r.end.is_empty() && study.cases.iter().any(|c| c.id == r.id))
         .collect();
-    if let Some(el) = results.elastica.first() {
+    if let Some(el) = results.measures.elastica.first() {
         s.push_str("## Load path (every 5th step)\n\n| step | P (kN) | elastica u/L | elastica v/L |");
         for r in &shown {
             let _ = write!(s, " {0} u/L | {0} v/L |", r.id);
@@ -128,7 +130,7 @@ pub fn report_markdown(results: &CantileverResults) -> String {
         }
         s.push('\n');
     }
-    s.push_str(&plane::failures_markdown(
+    s.push_str(&failures_markdown(
         results
             .cases
             .iter()
@@ -212,7 +214,7 @@ fn render_figure(
         }
         CantileverFigureKind::EndDisplacement => {
             let mut series = vec![];
-            for p in &results.elastica {
+            for p in &results.measures.elastica {
                 let plane = if p.plane_strain {
                     "plane strain"
                 } else {
@@ -265,13 +267,13 @@ fn render_figure(
 
 /// Render the report and figures from `dir`'s `results.json` and `domains.json`.
 pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
-    let results = read_results(dir)?;
-    let snapshots: BTreeMap<String, Vec<DomainSnapshot>> = plane::read_json(&dir.join("domains.json"))?;
+    let results: Results = read_results(dir)?;
+    let snapshots: BTreeMap<String, Vec<DomainSnapshot>> = read_json(&dir.join("domains.json"))?;
     let figures =
         results.study.figures.iter().map(|f| {
             render_figure(&results, &snapshots, dir, f).map(|svg| svg.map(|svg| (f.id.clone(), svg)))
         });
-    super::write_plane_files(
+    super::write_files(
         dir,
         (&results.study.report_file, report_markdown(&results)),
         std::iter::empty(),
@@ -280,10 +282,10 @@ pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
 }
 
 pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
-    let r = read_results(dir)?;
+    let r: Results = read_results(dir)?;
     Ok(super::plane_index_entry(
-        (r.study.name.clone(), r.study.summary.clone(), r.provenance.tier),
-        r.checks.clone(),
+        (&r.study.name, &r.study.summary, r.provenance.tier),
+        &r.checks,
         &r.study.report_file,
         std::iter::empty(),
         r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),

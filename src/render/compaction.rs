@@ -6,8 +6,11 @@ use crate::newton::ResidualNorm;
 use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, XyAxes, XySeries};
 use crate::problems::compaction::DomainRecord;
 use crate::study::compaction::*;
-use crate::study::plane::{self, IndexEntry};
-use crate::study::runner::CaseStatus;
+use crate::study::vocabulary::number;
+type Results = CompactionResults;
+use super::{checks_markdown, failures_markdown, IndexEntry};
+use crate::study::checks::check_counts;
+use crate::study::results::{read_json, read_results, CaseStatus};
 use crate::study::StudyError;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -92,7 +95,7 @@ fn figure17_table(results: &CompactionResults) -> String {
     hs.dedup();
     let ppcs: BTreeSet<usize> = cases.iter().filter_map(|c| c.points_per_cell).collect();
     let fems: BTreeSet<Method> = cases.iter().map(|c| c.method).filter(|m| m.is_fem()).collect();
-    let reference = results.reference.as_ref();
+    let reference = results.measures.reference.as_ref();
     let mut s = format!(
         "## Figure 17: maximum horizontal displacement\n\nBottom-right material point's horizontal displacement plus half the growth of its domain \
          (FEM: bottom-right node). Normalised by u_ref = {} ({}). Each cell: u, then u/u_ref.\n\n| h |",
@@ -175,7 +178,7 @@ fn cases_table(results: &CompactionResults) -> String {
             } else {
                 number(c.ghost_gamma)
             },
-            plane::status_word(c.status),
+            c.status.word(),
             u,
             c.weak_nodes_treated,
             if c.steps_cut == 0 {
@@ -197,7 +200,7 @@ fn cases_table(results: &CompactionResults) -> String {
 /// The main report.
 pub fn report_markdown(results: &CompactionResults) -> String {
     let spec = &results.study;
-    let (pass, fail, none) = plane::check_counts(&results.checks);
+    let (pass, fail, none) = check_counts(&results.checks);
     let count = |st| results.cases.iter().filter(|c| c.status == st).count();
     let mut s = format!(
         "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated. Cases: {} converged, {} failed, {} rejected.\n\n",
@@ -209,13 +212,13 @@ pub fn report_markdown(results: &CompactionResults) -> String {
         count(CaseStatus::Rejected)
     );
     s.push_str(&figure17_table(results));
-    s.push_str(&plane::checks_markdown(&results.checks));
+    s.push_str(&checks_markdown(&results.checks));
     for p in &spec.paper_residuals {
         let _ = writeln!(s, "- {}: [{}]({})", p.table, p.title, p.file);
     }
     s.push('\n');
     s.push_str(&cases_table(results));
-    s.push_str(&plane::failures_markdown(
+    s.push_str(&failures_markdown(
         results
             .cases
             .iter()
@@ -342,7 +345,7 @@ fn render_figure(
             xy_svg(&f.title, &axes, &series).map(Some).map_err(fail)
         }
         CompactionFigureKind::DisplacementConvergence => {
-            let Some(reference) = &results.reference else {
+            let Some(reference) = &results.measures.reference else {
                 return Ok(None);
             };
             let cases = results.sweep(&f.sweep);
@@ -393,8 +396,8 @@ type SeriesKey = (Method, Option<usize>);
 /// Render the report, the residual tables and the figures from `dir`'s `results.json` and
 /// `domains.json`. Returns the files written.
 pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
-    let results = read_results(dir)?;
-    let domains: BTreeMap<String, Vec<DomainRecord>> = plane::read_json(&dir.join("domains.json"))?;
+    let results: Results = read_results(dir)?;
+    let domains: BTreeMap<String, Vec<DomainRecord>> = read_json(&dir.join("domains.json"))?;
     let tables = results
         .study
         .paper_residuals
@@ -405,7 +408,7 @@ pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
         .figures
         .iter()
         .map(|f| render_figure(&results, &domains, dir, f).map(|svg| svg.map(|svg| (f.id.clone(), svg))));
-    super::write_plane_files(
+    super::write_files(
         dir,
         (&results.study.report_file, report_markdown(&results)),
         tables,
@@ -414,10 +417,10 @@ pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
 }
 
 pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
-    let r = read_results(dir)?;
+    let r: Results = read_results(dir)?;
     Ok(super::plane_index_entry(
-        (r.study.name.clone(), r.study.summary.clone(), r.provenance.tier),
-        r.checks.clone(),
+        (&r.study.name, &r.study.summary, r.provenance.tier),
+        &r.checks,
         &r.study.report_file,
         r.study
             .paper_residuals
@@ -425,9 +428,4 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
             .map(|p| (format!("{}: {}", p.table, p.title), p.file.clone())),
         r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
     ))
-}
-
-/// A number as the case ids write it (shortest round-trip form).
-fn number(x: f64) -> String {
-    format!("{x}")
 }

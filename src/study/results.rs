@@ -1,16 +1,19 @@
-//! What a column study's results.json holds: the case records, the fitted rates and
-//! comparisons, the sweep index and the timing. The runner fills it, the rate analysis reads
-//! and extends it, the renderer reads it only; this module imports none of them.
+//! The one results envelope every study kind writes as `results.json`: provenance, the study
+//! as parsed, the sweep index, the case records, the kind's measures (flattened), the checks
+//! and the timing, plus the records every kind shares (status, steps, failures). The engine
+//! fills it, each kind's measures extend it, the renderers read it only.
+//!
+//! `results.json` holds no wall-clock data except its `timing` block, so two runs compare
+//! equal after [`Envelope::without_timing`].
 
-use super::{Measure, StudySpec, Tier};
-use crate::newton::NewtonSettings;
-use crate::problems::column::Method;
+use super::checks::{check_counts, CheckRecord};
+use super::{StudyError, Tier};
+use crate::error::SolveError;
+use crate::load_stepping::StepReport;
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
-
-/// Header of the per-case point files.
-pub const POINTS_HEADER: &str = "z0,z,volume0,sigma_zz,f_zz";
-/// Header of the per-case point files of plastic studies (adds the lateral stress).
-pub const POINTS_HEADER_PLASTIC: &str = "z0,z,volume0,sigma_zz,f_zz,sigma_xx";
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -21,6 +24,16 @@ pub enum CaseStatus {
     Failed,
     /// The solver refused the input (see `failure.reason`); nothing was solved.
     Rejected,
+}
+
+impl CaseStatus {
+    pub fn word(self) -> &'static str {
+        match self {
+            CaseStatus::Converged => "converged",
+            CaseStatus::Failed => "failed",
+            CaseStatus::Rejected => "rejected",
+        }
+    }
 }
 
 /// Newton residual history of one converged load step.
@@ -42,41 +55,33 @@ pub struct FailureRecord {
     pub residuals: Vec<f64>,
 }
 
-/// Result of one case.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CaseRecord {
-    pub id: String,
-    pub method: Method,
-    /// Total weight W.
-    pub load: f64,
-    pub elements: usize,
-    /// `None` (null) for FEM.
-    pub points_per_cell: Option<usize>,
-    pub load_steps: usize,
-    pub newton: NewtonSettings,
-    pub status: CaseStatus,
-    pub failure: Option<FailureRecord>,
-    /// Eq (46), converged cases only.
-    pub stress_error: Option<f64>,
-    /// Eq (47) against the exact analytical base F, converged cases only.
-    pub f_error: Option<f64>,
-    /// Eq (46) on σ_xx (plastic studies only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sigma_xx_error: Option<f64>,
-    /// Yield height seen by the points (plastic studies only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub yield_height: Option<f64>,
-    /// |yield_height − analytical| / L0 (plastic studies only).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub yield_height_error: Option<f64>,
-    pub top_displacement: Option<f64>,
-    pub base_f: Option<f64>,
-    /// Number of material or Gauss points (rows of the point file).
-    pub points: usize,
-    /// Newton iterations summed over the converged steps.
-    pub newton_iterations: usize,
-    pub steps: Vec<StepRecord>,
-    pub wall_seconds: f64,
+/// Residual histories of converged load steps.
+pub fn step_records(steps: &[StepReport]) -> Vec<StepRecord> {
+    steps
+        .iter()
+        .map(|s| StepRecord {
+            step: s.step,
+            load_factor: s.load_factor,
+            residuals: s.newton.residuals.clone(),
+        })
+        .collect()
+}
+
+pub fn failure_record(e: &SolveError) -> FailureRecord {
+    FailureRecord {
+        step: e.step,
+        reason: e.failure.to_string(),
+        residuals: e.residuals.clone(),
+    }
+}
+
+/// A case that was not solved (step 0, no residuals).
+pub fn rejection(reason: impl Into<String>) -> FailureRecord {
+    FailureRecord {
+        step: 0,
+        reason: reason.into(),
+        residuals: vec![],
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -85,149 +90,240 @@ pub struct Software {
     pub version: String,
 }
 
+/// Header fields every `results.json` starts with.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    pub software: Software,
+    /// File name of the study file the inputs came from.
+    pub study_file: String,
+    pub tier: Tier,
+}
+
+impl Provenance {
+    pub fn new(study_file: &str, tier: Tier) -> Self {
+        Provenance {
+            software: Software {
+                name: env!("CARGO_PKG_NAME").to_string(),
+                version: env!("CARGO_PKG_VERSION").to_string(),
+            },
+            study_file: study_file.to_string(),
+            tier,
+        }
+    }
+
+    /// One line for the top of a report.
+    pub fn line(&self) -> String {
+        format!(
+            "Rendered from `results.json` by `study` ({} {}, {} tier, study file `{}`); regenerate, do not edit.",
+            self.software.name,
+            self.software.version,
+            self.tier.name(),
+            self.study_file
+        )
+    }
+}
+
 /// Wall-clock data: the only part of `results.json` that changes from run to run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Timing {
     pub wall_seconds: f64,
     pub threads: usize,
+    /// Wall seconds of each case, by case id (a resumed case keeps its original time).
+    pub cases: BTreeMap<String, f64>,
 }
 
-/// Everything the renderers need: `results.json`.
+impl Timing {
+    /// The same block with every time zeroed (case ids kept), for comparing two runs.
+    pub fn zeroed(&self) -> Self {
+        Timing {
+            wall_seconds: 0.0,
+            threads: 0,
+            cases: self.cases.keys().map(|k| (k.clone(), 0.0)).collect(),
+        }
+    }
+}
+
+/// Case ids of each sweep of the tier (a case may belong to several sweeps).
+pub type SweepIndex = BTreeMap<String, Vec<String>>;
+
+/// `results.json` of any study kind: `S` the study file, `C` a case record, `M` the kind's
+/// measures (flattened into the top level).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StudyResults {
-    pub software: Software,
-    /// File name of the study file the inputs came from.
-    pub study_file: String,
-    pub tier: Tier,
+pub struct Envelope<S, C, M> {
+    #[serde(flatten)]
+    pub provenance: Provenance,
     /// The study inputs as parsed.
-    pub study: StudySpec,
-    /// Case ids of each sweep.
-    pub sweep_cases: CaseIndex,
-    pub cases: Vec<CaseRecord>,
-    pub rates: Vec<RateRecord>,
-    pub comparisons: Vec<ComparisonRecord>,
-    /// The analytical column at every load the cases, tables and figures use, evaluated when
-    /// the study is solved (so that rendering reads only this file).
-    #[serde(default)]
-    pub analytical: Vec<AnalyticalRecord>,
+    pub study: S,
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub sweep_cases: SweepIndex,
+    pub cases: Vec<C>,
+    #[serde(flatten)]
+    pub measures: M,
+    /// Every claim of the paper or the study file checked against the results.
+    pub checks: Vec<CheckRecord>,
     pub timing: Timing,
 }
 
-/// Samples of the analytical profile ([`AnalyticalRecord::profile`]): 401 equally spaced
-/// reference heights, 0 to L0.
-pub const PROFILE_SAMPLES: usize = 400;
-
-/// The analytical column (eqs 42–45, Appendix A) at one load.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct AnalyticalRecord {
-    pub load: f64,
-    /// u(L0).
-    pub top_displacement: f64,
-    /// F(0), the base deformation gradient of eq (47).
-    pub base_f: f64,
-    /// Height where yield starts (Kirchhoff criterion); `None` if elastic throughout.
-    pub yield_height: Option<f64>,
-    /// The paper's L0 − ρy/(ρ0 g) (Cauchy criterion), for plastic studies.
-    pub paper_yield_height: Option<f64>,
-    /// (Z, z = Z + u(Z), σzz, σxx) at [`PROFILE_SAMPLES`] + 1 reference heights Z.
-    pub profile: Vec<[f64; 4]>,
+/// What an envelope's case records say of themselves.
+pub trait CaseRecordOf {
+    fn id(&self) -> &str;
+    fn status(&self) -> CaseStatus;
 }
 
-impl StudyResults {
-    /// The analytical column at `load`, if the run recorded it.
-    pub fn analytical_at(&self, load: f64) -> Option<&AnalyticalRecord> {
-        self.analytical.iter().find(|a| a.load == load)
+/// [`CaseRecordOf`] for a record with `id: String` and `status: CaseStatus` fields.
+macro_rules! case_record {
+    ($record:ty) => {
+        impl $crate::study::results::CaseRecordOf for $record {
+            fn id(&self) -> &str {
+                &self.id
+            }
+            fn status(&self) -> $crate::study::results::CaseStatus {
+                self.status
+            }
+        }
+    };
+}
+pub(crate) use case_record;
+
+/// What every kind records of one solve: status, failure, Newton iterations and the
+/// residual histories of the converged steps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolveRecord {
+    pub status: CaseStatus,
+    pub failure: Option<FailureRecord>,
+    pub newton_iterations: usize,
+    pub steps: Vec<StepRecord>,
+}
+
+impl SolveRecord {
+    /// The record of a solve that ran `steps` and stopped at `failure` (if any).
+    pub fn of(steps: &[StepReport], failure: Option<&SolveError>) -> Self {
+        SolveRecord {
+            status: if failure.is_some() {
+                CaseStatus::Failed
+            } else {
+                CaseStatus::Converged
+            },
+            failure: failure.map(failure_record),
+            newton_iterations: steps.iter().map(|s| s.newton.iterations()).sum(),
+            steps: step_records(steps),
+        }
     }
 
-    pub fn case(&self, id: &str) -> Option<&CaseRecord> {
-        self.cases.iter().find(|c| c.id == id)
+    /// A case whose input the solver refused (nothing solved).
+    pub fn rejected(reason: impl std::fmt::Display) -> Self {
+        SolveRecord {
+            status: CaseStatus::Rejected,
+            failure: Some(rejection(reason.to_string())),
+            newton_iterations: 0,
+            steps: vec![],
+        }
+    }
+}
+
+impl<S: Clone, C: Clone + CaseRecordOf, M: Clone> Envelope<S, C, M> {
+    pub fn case(&self, id: &str) -> Option<&C> {
+        self.cases.iter().find(|c| c.id() == id)
     }
 
-    /// Copy with every wall-clock field zeroed, for comparing two runs.
+    /// The cases of a sweep, in plan order.
+    pub fn sweep(&self, id: &str) -> Vec<&C> {
+        self.sweep_cases
+            .get(id)
+            .map_or(vec![], |ids| ids.iter().filter_map(|i| self.case(i)).collect())
+    }
+
+    /// Copy with the wall-clock times zeroed.
     pub fn without_timing(&self) -> Self {
         let mut r = self.clone();
-        r.timing = Timing {
-            wall_seconds: 0.0,
-            threads: 0,
-        };
-        r.cases.iter_mut().for_each(|c| c.wall_seconds = 0.0);
+        r.timing = r.timing.zeroed();
         r
     }
 
-    /// Rates and comparisons with an expectation: (passed, failed, not evaluated).
+    /// (passed, failed, not evaluated) checks.
     pub fn check_counts(&self) -> (usize, usize, usize) {
-        let passes = self
-            .rates
-            .iter()
-            .filter(|r| r.expected.is_some())
-            .map(|r| r.pass)
-            .chain(self.comparisons.iter().map(|c| c.pass));
-        let mut n = (0, 0, 0);
-        for p in passes {
-            match p {
-                Some(true) => n.0 += 1,
-                Some(false) => n.1 += 1,
-                None => n.2 += 1,
-            }
+        check_counts(&self.checks)
+    }
+
+    pub fn summary(&self, resumed: usize) -> RunSummary {
+        RunSummary::new(self.cases.iter().map(|c| c.status()), &self.checks).with_resumed(resumed)
+    }
+}
+
+/// Outcome of running one study file (for the binary's summary line).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSummary {
+    pub cases: usize,
+    pub failed: usize,
+    pub rejected: usize,
+    pub checks: (usize, usize, usize),
+    /// Cases read back from the case store (`--resume`).
+    pub resumed: usize,
+}
+
+impl RunSummary {
+    pub fn new(statuses: impl Iterator<Item = CaseStatus>, checks: &[CheckRecord]) -> Self {
+        let mut r = RunSummary {
+            cases: 0,
+            failed: 0,
+            rejected: 0,
+            checks: check_counts(checks),
+            resumed: 0,
+        };
+        for s in statuses {
+            r.cases += 1;
+            r.failed += usize::from(s == CaseStatus::Failed);
+            r.rejected += usize::from(s == CaseStatus::Rejected);
         }
-        n
+        r
+    }
+
+    pub fn with_resumed(mut self, resumed: usize) -> Self {
+        self.resumed = resumed;
+        self
     }
 }
 
-/// The band a fitted rate must fall in, with its source.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ExpectedBand {
-    pub rate: f64,
-    pub tolerance: f64,
-    pub source: String,
-}
-
-/// Fitted rate of one series.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct RateRecord {
-    pub sweep: String,
-    pub method: Method,
-    pub load: f64,
-    pub points_per_cell: Option<usize>,
-    pub measure: Measure,
-    /// Slope of log(error) against log(h); `None` with fewer than two converged cases.
-    pub slope: Option<f64>,
-    /// Element counts the fit used.
-    pub elements_used: Vec<usize>,
-    pub expected: Option<ExpectedBand>,
-    /// `None` when nothing is expected, or the series was not run in this tier.
-    pub pass: Option<bool>,
-}
-
-/// Outcome of an `[[compare]]` check.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ComparisonRecord {
-    pub sweep: String,
-    pub load: f64,
-    pub measure: Measure,
-    pub lower: Method,
-    pub higher: Method,
-    /// Element counts where both methods converged.
-    pub elements_checked: Vec<usize>,
-    /// error(lower) / error(higher) at each checked element count.
-    pub ratios: Vec<f64>,
-    /// `None` when no element count could be checked.
-    pub pass: Option<bool>,
-    pub source: String,
-}
-
-/// Which case ids belong to which sweep (a case may belong to several).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct CaseIndex {
-    /// (sweep id, case ids in run order).
-    pub sweeps: Vec<(String, Vec<String>)>,
-}
-
-impl CaseIndex {
-    pub fn of_sweep(&self, id: &str) -> &[String] {
-        self.sweeps
-            .iter()
-            .find(|(s, _)| s == id)
-            .map_or(&[], |(_, v)| v.as_slice())
+/// Write `value` as JSON (pretty or compact), atomically.
+pub fn write_json<T: Serialize>(path: &Path, value: &T, pretty: bool) -> Result<(), StudyError> {
+    let text = if pretty {
+        serde_json::to_string_pretty(value)
+    } else {
+        serde_json::to_string(value)
     }
+    .map_err(|e| StudyError::io(path, e))?;
+    super::store::write_file(path, (text + "\n").as_bytes())
+}
+
+pub fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T, StudyError> {
+    let text = std::fs::read_to_string(path).map_err(|e| StudyError::io(path, e))?;
+    serde_json::from_str(&text).map_err(|e| StudyError::Parse {
+        file: path.display().to_string(),
+        message: e.to_string(),
+    })
+}
+
+/// Read `<dir>/results.json`.
+pub fn read_results<T: DeserializeOwned>(dir: &Path) -> Result<T, StudyError> {
+    read_json(&dir.join("results.json"))
+}
+
+/// Write `text` to `path` atomically and note it in `written`.
+pub fn write_text(path: &Path, text: &str, written: &mut Vec<PathBuf>) -> Result<(), StudyError> {
+    super::store::write_file(path, text.as_bytes())?;
+    written.push(path.to_path_buf());
+    Ok(())
+}
+
+/// The `problem` key of a study file, if it has one.
+pub fn problem_of_study(text: &str) -> Option<String> {
+    let v: toml::Value = toml::from_str(text).ok()?;
+    v.get("problem")?.as_str().map(str::to_string)
+}
+
+/// The `study.problem` recorded in `<dir>/results.json`, if readable.
+pub fn problem_of_results(dir: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(dir.join("results.json")).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    v.get("study")?.get("problem")?.as_str().map(str::to_string)
 }

@@ -6,10 +6,20 @@
 //! Everything is written to temporary folders, never to the repository's `reports/`.
 
 use igimp::render::cantilever::render;
-use igimp::study::cantilever::{read_results, run_study, write_outputs, CantileverRun, CantileverStudy};
-use igimp::study::plane::PlaneStudy;
-use igimp::study::runner::CaseStatus;
+use igimp::study::cantilever::{CantileverResults, CantileverStudy};
+use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
+use igimp::study::results::CaseStatus;
 use igimp::study::Tier;
+
+type CantileverRun = Run<CantileverStudy>;
+
+fn run_study(s: &CantileverStudy, file: &str, tier: Tier) -> CantileverRun {
+    run_in_memory(s, file, tier).expect("an in-memory run")
+}
+
+fn read_results(dir: &Path) -> Result<CantileverResults, igimp::study::StudyError> {
+    igimp::study::results::read_results(dir)
+}
 use std::path::Path;
 use std::process::Command;
 use std::sync::OnceLock;
@@ -93,7 +103,7 @@ fn cantilever_quick_outputs_rerender_byte_identically_and_runs_repeat() {
     let files = render(&dir).unwrap();
     // serde_json may move a float by one ulp on the way back, so compare what the checks say.
     let parsed = read_results(&dir).unwrap();
-    let verdicts = |c: &[igimp::study::plane::CheckRecord]| -> Vec<(String, Option<bool>)> {
+    let verdicts = |c: &[igimp::study::checks::CheckRecord]| -> Vec<(String, Option<bool>)> {
         c.iter().map(|c| (c.id.clone(), c.pass)).collect()
     };
     assert_eq!(verdicts(&parsed.checks), verdicts(&quick().results.checks));
@@ -114,5 +124,5 @@ fn cantilever_quick_outputs_rerender_byte_identically_and_runs_repeat() {
 
     let again = run_study(&study(), "cantilever.toml", Tier::Quick);
     assert_eq!(again.results.without_timing(), quick().results.without_timing());
-    assert_eq!(again.snapshots, quick().snapshots);
+    assert_eq!(again.outputs, quick().outputs);
 }

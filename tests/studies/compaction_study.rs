@@ -5,10 +5,20 @@
 //! Everything is written to temporary folders, never to the repository's `reports/`.
 
 use igimp::render::compaction::render;
-use igimp::study::compaction::{read_results, run_study, write_outputs, CompactionRun, CompactionStudy};
-use igimp::study::plane::PlaneStudy;
-use igimp::study::runner::CaseStatus;
+use igimp::study::compaction::{CompactionResults, CompactionStudy};
+use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
+use igimp::study::results::CaseStatus;
 use igimp::study::Tier;
+
+type CompactionRun = Run<CompactionStudy>;
+
+fn run_study(s: &CompactionStudy, file: &str, tier: Tier) -> CompactionRun {
+    run_in_memory(s, file, tier).expect("an in-memory run")
+}
+
+fn read_results(dir: &Path) -> Result<CompactionResults, igimp::study::StudyError> {
+    igimp::study::results::read_results(dir)
+}
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -45,7 +55,7 @@ fn compaction_quick_outputs_rerender_byte_identically() {
     let parsed = read_results(&dir).unwrap();
     assert_eq!(parsed.cases.len(), quick().results.cases.len());
     // serde_json may move a float by one ulp on the way back, so compare what the checks say.
-    let verdicts = |c: &[igimp::study::plane::CheckRecord]| -> Vec<(String, Option<bool>)> {
+    let verdicts = |c: &[igimp::study::checks::CheckRecord]| -> Vec<(String, Option<bool>)> {
         c.iter().map(|c| (c.id.clone(), c.pass)).collect()
     };
     assert_eq!(verdicts(&parsed.checks), verdicts(&quick().results.checks));
@@ -94,7 +104,7 @@ fn compaction_quick_outputs_rerender_byte_identically() {
 fn compaction_quick_tier_is_deterministic() {
     let again = run_study(&study(), "compaction.toml", Tier::Quick);
     assert_eq!(again.results.without_timing(), quick().results.without_timing());
-    assert_eq!(again.domains, quick().domains);
+    assert_eq!(again.outputs, quick().outputs);
 }
 
 /// Figure 17 (paper §5.2): for h ≤ 1/2 every points-per-cell setting that completes lies within
@@ -104,7 +114,7 @@ fn compaction_quick_tier_is_deterministic() {
 #[test]
 fn compaction_figure17_within_one_percent_of_fem_reference() {
     let r = &quick().results;
-    let reference = r.reference.as_ref().expect("a reference");
+    let reference = r.measures.reference.as_ref().expect("a reference");
     assert_eq!(reference.method.name(), "fem-q4", "{reference:?}");
     let completed: Vec<_> = r
         .sweep("fig17")

@@ -4,11 +4,24 @@
 //!
 //! Everything is written to temporary folders, never to the repository's `reports/`.
 
-use igimp::problems::column::Method;
+use igimp::method::Method;
 use igimp::render::column as report;
-use igimp::study::rates::RateRecord;
-use igimp::study::runner::{read_results, run_study, write_outputs, CaseStatus, StudyRun};
-use igimp::study::{Measure, StudyError, StudySpec, Tier};
+use igimp::study::column::rates::RateRecord;
+use igimp::study::column::records::ColumnResults;
+use igimp::study::column::{Measure, StudySpec};
+use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
+use igimp::study::results::CaseStatus;
+use igimp::study::{StudyError, Tier};
+
+type StudyRun = Run<StudySpec>;
+
+fn run_study(s: &StudySpec, file: &str, tier: Tier, _on_done: &dyn Fn(&str)) -> StudyRun {
+    run_in_memory(s, file, tier).expect("an in-memory run")
+}
+
+fn read_results(dir: &std::path::Path) -> Result<ColumnResults, StudyError> {
+    igimp::study::results::read_results(dir)
+}
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
@@ -37,6 +50,7 @@ fn is_fem(m: Method) -> bool {
 fn expected_rate(method: Method, measure: Measure) -> &'static RateRecord {
     quick()
         .results
+        .measures
         .rates
         .iter()
         .find(|r| r.method == method && r.measure == measure && r.expected.is_some())
@@ -67,6 +81,7 @@ fn igimp_quick_tier_rates_inside_study_bands() {
     let run = quick();
     let checked: Vec<&RateRecord> = run
         .results
+        .measures
         .rates
         .iter()
         .filter(|r| r.expected.is_some() && !is_fem(r.method))
@@ -85,6 +100,7 @@ fn igimp_quick_tier_rates_inside_study_bands() {
     }
     for c in run
         .results
+        .measures
         .comparisons
         .iter()
         .filter(|c| !is_fem(c.lower) && !is_fem(c.higher))
@@ -130,6 +146,7 @@ fn fem_quadratic_stress_error_rate_is_2() {
 fn igimp_stress_error_below_linear_fem_at_equal_elements() {
     let c = quick()
         .results
+        .measures
         .comparisons
         .iter()
         .find(|c| c.lower == Method::Igimp && c.higher == Method::FemLinear)
@@ -146,7 +163,7 @@ fn study_runs_are_repeatable_and_results_json_parses() {
     let spec = StudySpec::load(&column_file()).unwrap();
     let second = run_study(&spec, "column.toml", Tier::Quick, &|_| {});
     assert_eq!(first.results.without_timing(), second.results.without_timing());
-    assert_eq!(first.points, second.points);
+    assert_eq!(first.outputs, second.outputs);
     let dir = tempfile::tempdir().unwrap();
     let a = write_outputs(&dir.path().join("a"), first).unwrap();
     let b = write_outputs(&dir.path().join("b"), &second).unwrap();
@@ -154,13 +171,15 @@ fn study_runs_are_repeatable_and_results_json_parses() {
     let rb = read_results(&b).unwrap();
     assert_eq!(ra.without_timing(), rb.without_timing());
     assert_eq!(ra.cases.len(), first.results.cases.len());
+    // The `timing` block (wall seconds, threads, seconds per case) is last.
     let strip = |p: &Path| -> String {
-        std::fs::read_to_string(p.join("results.json"))
-            .unwrap()
-            .lines()
-            .filter(|l| !l.contains("wall_seconds") && !l.contains("\"threads\""))
-            .collect::<Vec<_>>()
-            .join("\n")
+        let text = std::fs::read_to_string(p.join("results.json")).unwrap();
+        let end = text.find("\"timing\": {").expect("a timing block");
+        assert!(
+            !text[..end].contains("seconds"),
+            "wall-clock data outside `timing`"
+        );
+        text[..end].to_string()
     };
     assert_eq!(
         strip(&a),
@@ -396,7 +415,7 @@ measure = "stress_error"
     // The failure is in results.json and the report, and rendering still works.
     let dir = tempfile::tempdir().unwrap();
     let sdir = write_outputs(dir.path(), &run).unwrap();
-    report::render_study(&sdir).unwrap();
+    report::render(&sdir).unwrap();
     let table = std::fs::read_to_string(sdir.join("table.md")).unwrap();
     assert!(table.contains("failed") && table.contains(&failed.id), "{table}");
 }
@@ -412,6 +431,7 @@ fn plastic_column_quick_tier_meets_its_bands_and_yield_height() {
     let run = run_study(&spec, "column-plastic.toml", Tier::Quick, &|_| {});
     let expected: Vec<&RateRecord> = run
         .results
+        .measures
         .rates
         .iter()
         .filter(|r| r.expected.is_some())
@@ -420,7 +440,7 @@ fn plastic_column_quick_tier_meets_its_bands_and_yield_height() {
     for r in expected {
         assert_in_band(r);
     }
-    for c in &run.results.comparisons {
+    for c in &run.results.measures.comparisons {
         assert_eq!(c.pass, Some(true), "comparison failed: {c:?}");
     }
     let dir = tempfile::tempdir().unwrap();
@@ -432,7 +452,8 @@ fn plastic_column_quick_tier_meets_its_bands_and_yield_height() {
         .filter(|c| c.method == Method::Igimp && c.load == 400000.0)
         .max_by_key(|c| c.elements)
         .unwrap();
-    let csv = std::fs::read_to_string(study_dir.join(igimp::study::runner::points_file(&finest.id))).unwrap();
+    let csv =
+        std::fs::read_to_string(study_dir.join(igimp::study::column::kind::points_file(&finest.id))).unwrap();
     assert!(csv.starts_with("z0,z,volume0,sigma_zz,f_zz,sigma_xx\n"));
     let zy = finest.yield_height.expect("yield height");
     let h = 50.0 / finest.elements as f64;
@@ -441,6 +462,6 @@ fn plastic_column_quick_tier_meets_its_bands_and_yield_height() {
         (zy - 46.25).abs() > 5.0 * (zy - 46.135795).abs(),
         "yield height {zy} is not clearly closer to the Kirchhoff criterion than to the paper's formula"
     );
-    report::render_study(&study_dir).unwrap();
+    report::render(&study_dir).unwrap();
     assert!(study_dir.join("fig13.svg").exists() && study_dir.join("table.md").exists());
 }

@@ -2,7 +2,9 @@
 //! reader (Python meshio), a sweep killed part-way and resumed, and results that do not
 //! depend on the number of threads.
 
-use igimp::study::runner::{read_points_csv, read_results, StudyResults};
+use igimp::study::column::kind::read_points_csv;
+use igimp::study::column::records::ColumnResults as StudyResults;
+use igimp::study::results::read_results;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -160,7 +162,7 @@ fn vtk_output_read_by_meshio_matches_results_json_and_point_files() {
     write_study(tmp.path(), "tiny", TINY);
     run(tmp.path(), "tiny", "out", 2, &["--vtk-every", "2"]);
     let sdir = tmp.path().join("out/tiny");
-    let res = read_results(&sdir).unwrap();
+    let res: StudyResults = read_results(&sdir).unwrap();
     assert_eq!(res.cases.len(), 3);
     for case in &res.cases {
         let pvd = std::fs::read_to_string(sdir.join(format!("vtk/{}.pvd", case.id))).unwrap();
@@ -388,8 +390,8 @@ fn plane_studies_resume_and_write_vtk() {
     let (resumed, total) = resumed_count(&stderr);
     assert!((1..total).contains(&resumed), "resumed {resumed} of {total}");
     run_repo_quick(tmp.path(), "compaction", "clean", 2, &[]);
-    let a = compaction::read_results(&tmp.path().join("killed/compaction")).unwrap();
-    let b = compaction::read_results(&tmp.path().join("clean/compaction")).unwrap();
+    let a = read_results::<compaction::CompactionResults>(&tmp.path().join("killed/compaction")).unwrap();
+    let b = read_results::<compaction::CompactionResults>(&tmp.path().join("clean/compaction")).unwrap();
     assert_eq!(a.without_timing(), b.without_timing());
 
     run_repo_quick(tmp.path(), "cantilever", "killed", 2, &["--vtk"]);
@@ -407,8 +409,8 @@ fn plane_studies_resume_and_write_vtk() {
     let (resumed, total) = resumed_count(&stderr);
     assert_eq!(resumed, total - files.len().div_ceil(2), "{stderr}");
     run_repo_quick(tmp.path(), "cantilever", "clean", 2, &[]);
-    let a = cantilever::read_results(&tmp.path().join("killed/cantilever")).unwrap();
-    let b = cantilever::read_results(&tmp.path().join("clean/cantilever")).unwrap();
+    let a = read_results::<cantilever::CantileverResults>(&tmp.path().join("killed/cantilever")).unwrap();
+    let b = read_results::<cantilever::CantileverResults>(&tmp.path().join("clean/cantilever")).unwrap();
     assert_eq!(a.without_timing(), b.without_timing());
 
     // ParaView files: one .pvd per iGIMP case; the final frame of Figure 15's case holds the
@@ -526,7 +528,7 @@ fn sharded_runs_merge_to_the_unsharded_results() {
         results(tmp.path(), "sharded", "tiny").without_timing(),
         results(tmp.path(), "whole", "tiny").without_timing()
     );
-    let a = compaction::read_results(&tmp.path().join("sharded/compaction")).unwrap();
-    let b = compaction::read_results(&tmp.path().join("whole/compaction")).unwrap();
+    let a = read_results::<compaction::CompactionResults>(&tmp.path().join("sharded/compaction")).unwrap();
+    let b = read_results::<compaction::CompactionResults>(&tmp.path().join("whole/compaction")).unwrap();
     assert_eq!(a.without_timing(), b.without_timing());
 }

@@ -5,11 +5,13 @@
 //! one series (method, weight, points per cell). Pairwise log2 rates per refinement are
 //! computed by [`pairwise_rates`] for the tables.
 
-pub use super::results::{CaseIndex, ComparisonRecord, ExpectedBand, RateRecord};
-use super::results::{CaseRecord, CaseStatus};
-use super::{Measure, StudySpec, Tier};
-use crate::norms::fitted_rate;
-use crate::problems::column::Method;
+use super::records::CaseRecord;
+pub use super::records::{ComparisonRecord, ExpectedBand, RateRecord};
+use super::{Measure, StudySpec};
+use crate::method::Method;
+use crate::study::checks::fitted_rate_finest;
+use crate::study::results::{CaseStatus, SweepIndex};
+use crate::study::Tier;
 
 /// The error of a case under a measure (converged cases only).
 pub fn case_error(case: &CaseRecord, measure: Measure) -> Option<f64> {
@@ -62,7 +64,7 @@ pub fn compute_rates(
     spec: &StudySpec,
     tier: Tier,
     cases: &[CaseRecord],
-    case_ids: &CaseIndex,
+    case_ids: &SweepIndex,
 ) -> Vec<RateRecord> {
     let mut out = Vec::new();
     for sweep in &spec.sweeps {
@@ -72,7 +74,7 @@ pub fn compute_rates(
         if plan.elements.len() < 2 {
             continue;
         }
-        let ids = case_ids.of_sweep(&sweep.id);
+        let ids = case_ids.get(&sweep.id).map_or(&[][..], |v| v.as_slice());
         for &method in &plan.methods {
             let ppcs: Vec<Option<usize>> = if method.uses_material_points() {
                 plan.points_per_cell.iter().map(|&p| Some(p)).collect()
@@ -87,17 +89,17 @@ pub fn compute_rates(
                             .iter()
                             .filter_map(|c| case_error(c, measure).map(|e| (c.elements, e)))
                             .collect();
-                        let n = sweep.fit_points.map_or(pts.len(), |n| n as usize).min(pts.len());
+                        let h: Vec<f64> = pts.iter().map(|p| spec.column.length / p.0 as f64).collect();
+                        let e: Vec<f64> = pts.iter().map(|p| p.1).collect();
+                        let (slope, n) = fitted_rate_finest(&h, &e, sweep.fit_points.map(|n| n as usize));
                         let used = &pts[pts.len() - n..];
-                        let h: Vec<f64> = used.iter().map(|p| spec.column.length / p.0 as f64).collect();
-                        let e: Vec<f64> = used.iter().map(|p| p.1).collect();
                         out.push(RateRecord {
                             sweep: sweep.id.clone(),
                             method,
                             load,
                             points_per_cell: ppc,
                             measure,
-                            slope: fitted_rate(&h, &e),
+                            slope,
                             elements_used: used.iter().map(|p| p.0).collect(),
                             expected: None,
                             pass: None,
@@ -152,7 +154,7 @@ pub fn compute_comparisons(
     spec: &StudySpec,
     tier: Tier,
     cases: &[CaseRecord],
-    case_ids: &CaseIndex,
+    case_ids: &SweepIndex,
 ) -> Vec<ComparisonRecord> {
     spec.compare
         .iter()
@@ -162,7 +164,7 @@ pub fn compute_comparisons(
             let mut elements_checked = vec![];
             let mut ratios = vec![];
             if let Some(plan) = spec.plan(sweep, tier) {
-                let ids = case_ids.of_sweep(&sweep.id);
+                let ids = case_ids.get(&sweep.id).map_or(&[][..], |v| v.as_slice());
                 let pick = |m: Method| -> Vec<&CaseRecord> {
                     let ppcs: Vec<Option<usize>> = if m.uses_material_points() {
                         plan.points_per_cell.iter().map(|&p| Some(p)).collect()

@@ -1,108 +1,14 @@
-//! Markdown tables, figures and the reports index, rendered from a study's `results.json`
-//! (and, for stress profiles, the point files written beside it) and nothing else, so that
-//! `study --render-only` reproduces them byte for byte.
+//! The column study's Markdown report: Table 1 beside the paper's values, the cases, the
+//! fitted rates with their bands and the comparisons.
 
-use crate::plot::{self, ConvergenceSeries, ProfileSeries};
-use crate::problems::column::Method;
-use crate::study::rates::{case_error, pairwise_rates, series};
-use crate::study::results::AnalyticalRecord;
-use crate::study::runner::{
-    points_file, read_points_csv, read_results, CaseRecord, CaseStatus, StudyResults,
-};
-use crate::study::{weight_label, FigureKind, FigureSpec, Measure, StudyError};
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-
-fn series_label(m: Method, ppc: Option<usize>) -> String {
-    match ppc {
-        Some(p) => format!("{}, {p} point{}/cell", m.label(), if p == 1 { "" } else { "s" }),
-        None => m.label().to_string(),
-    }
-}
-
-fn e3(x: Option<f64>) -> String {
-    x.map_or("—".into(), |v| format!("{v:.3e}"))
-}
-
-fn rate(x: Option<f64>) -> String {
-    x.map_or("—".into(), |v| format!("{v:.2}"))
-}
-
-fn status_word(c: &CaseRecord) -> &'static str {
-    match c.status {
-        CaseStatus::Converged => "converged",
-        CaseStatus::Failed => "failed",
-        CaseStatus::Rejected => "rejected",
-    }
-}
-
-/// The analytical column at `load` as the run recorded it.
-fn analytical_at(results: &StudyResults, load: f64) -> Result<&AnalyticalRecord, StudyError> {
-    results.analytical_at(load).ok_or_else(|| StudyError::Parse {
-        file: "results.json".into(),
-        message: format!(
-            "no analytical record for W = {load} (results written by an older igimp: solve again)"
-        ),
-    })
-}
-
-/// The (method, points per cell) series of a sweep at one load, in plan order.
-fn sweep_series(results: &StudyResults, sweep_id: &str, load: f64) -> Vec<(Method, Option<usize>)> {
-    let spec = &results.study;
-    let Some(plan) = spec.sweep(sweep_id).and_then(|s| spec.plan(s, results.tier)) else {
-        return vec![];
-    };
-    if !plan.weights.contains(&load) {
-        return vec![];
-    }
-    let mut out = vec![];
-    for &m in &plan.methods {
-        if m.uses_material_points() {
-            out.extend(plan.points_per_cell.iter().map(|&p| (m, Some(p))));
-        } else {
-            out.push((m, None));
-        }
-    }
-    out
-}
-
-fn fitted(
-    results: &StudyResults,
-    sweep: &str,
-    m: Method,
-    load: f64,
-    ppc: Option<usize>,
-    measure: Measure,
-) -> Option<f64> {
-    results
-        .rates
-        .iter()
-        .find(|r| {
-            r.sweep == sweep
-                && r.method == m
-                && r.load == load
-                && r.points_per_cell == ppc
-                && r.measure == measure
-        })
-        .and_then(|r| r.slope)
-}
+use super::*;
 
 /// The Markdown report of one study.
-pub fn report_markdown(results: &StudyResults) -> String {
+pub fn report_markdown(results: &ColumnResults) -> String {
     let spec = &results.study;
     let mut s = String::new();
     let _ = writeln!(s, "# {}: {}\n", spec.name, spec.summary);
-    let _ = writeln!(
-        s,
-        "Rendered from `results.json` by `study` ({} {}, {} tier, study file `{}`); regenerate, do not edit.\n",
-        results.software.name,
-        results.software.version,
-        match results.tier {
-            crate::study::Tier::Full => "full",
-            crate::study::Tier::Quick => "quick",
-        },
-        results.study_file
-    );
+    let _ = writeln!(s, "{}\n", results.provenance.line());
     let (pass, fail, none) = results.check_counts();
     let _ = writeln!(
         s,
@@ -138,7 +44,7 @@ pub fn report_markdown(results: &StudyResults) -> String {
              so both are shown.\n",
             exact.top_displacement, f0, p.analytical_base_f, p.analytical_base_f, p.analytical_base_f
         );
-        let ids = results.sweep_cases.of_sweep(&p.sweep);
+        let ids = of_sweep(results, &p.sweep);
         let cases: Vec<Option<&CaseRecord>> = p
             .elements
             .iter()
@@ -250,13 +156,13 @@ pub fn report_markdown(results: &StudyResults) -> String {
          element counts listed in the rates table.\n"
     );
     for sweep in &spec.sweeps {
-        let Some(plan) = spec.plan(sweep, results.tier) else {
+        let Some(plan) = spec.plan(sweep, results.provenance.tier) else {
             continue;
         };
         if plan.elements.len() < 2 {
             continue;
         }
-        let ids = results.sweep_cases.of_sweep(&sweep.id);
+        let ids = of_sweep(results, &sweep.id);
         let _ = writeln!(s, "### Sweep `{}`: {}\n", sweep.id, sweep.title);
         for &load in &plan.weights {
             for (m, ppc) in sweep_series(results, &sweep.id, load) {
@@ -335,7 +241,12 @@ pub fn report_markdown(results: &StudyResults) -> String {
         }
     }
 
-    let expected: Vec<_> = results.rates.iter().filter(|r| r.expected.is_some()).collect();
+    let expected: Vec<_> = results
+        .measures
+        .rates
+        .iter()
+        .filter(|r| r.expected.is_some())
+        .collect();
     if !expected.is_empty() {
         let _ = writeln!(s, "## Expected rates\n");
         let _ = writeln!(
@@ -370,14 +281,14 @@ pub fn report_markdown(results: &StudyResults) -> String {
         }
         s.push('\n');
     }
-    if !results.comparisons.is_empty() {
+    if !results.measures.comparisons.is_empty() {
         let _ = writeln!(s, "## Error comparisons\n");
         let _ = writeln!(
             s,
             "| sweep | W | measure | expected | elements checked | largest ratio | result | source |"
         );
         let _ = writeln!(s, "|---|---:|---|---|---|---:|---|---|");
-        for c in &results.comparisons {
+        for c in &results.measures.comparisons {
             let worst = c
                 .ratios
                 .iter()
@@ -432,170 +343,4 @@ pub fn report_markdown(results: &StudyResults) -> String {
         }
     }
     s
-}
-
-fn pass_word(p: Option<bool>) -> &'static str {
-    match p {
-        Some(true) => "pass",
-        Some(false) => "FAIL",
-        None => "not run",
-    }
-}
-
-/// Draw one figure of the study (SVG text).
-pub fn render_figure(
-    results: &StudyResults,
-    study_dir: &Path,
-    fig: &FigureSpec,
-) -> Result<String, StudyError> {
-    let ids = results.sweep_cases.of_sweep(&fig.sweep);
-    let file_err = |e: String| StudyError::Io {
-        path: study_dir.join(format!("{}.svg", fig.id)).display().to_string(),
-        message: e,
-    };
-    match fig.kind {
-        FigureKind::Profile => {
-            let mut series_out = vec![];
-            for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {
-                for c in series(&results.cases, ids, m, fig.weight, ppc) {
-                    if c.status != CaseStatus::Converged {
-                        continue;
-                    }
-                    let rows = read_points_csv(&study_dir.join(points_file(&c.id)))?;
-                    series_out.push(ProfileSeries {
-                        label: format!("σzz, {}, {} elements", series_label(m, ppc), c.elements),
-                        points: rows.iter().map(|r| (r[3], r[1])).collect(),
-                    });
-                }
-            }
-            let exact = analytical_at(results, fig.weight)?;
-            let mut curves = vec![ProfileSeries {
-                label: "analytical σzz, eqs (42)-(45)".into(),
-                points: exact.profile.iter().map(|r| (r[2], r[1])).collect(),
-            }];
-            let plastic = results.study.column.yield_stress.is_some();
-            if plastic {
-                // The lateral stress is recorded in the sixth column of plastic point files.
-                for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {
-                    for c in series(&results.cases, ids, m, fig.weight, ppc) {
-                        if c.status != CaseStatus::Converged {
-                            continue;
-                        }
-                        let rows = read_points_csv(&study_dir.join(points_file(&c.id)))?;
-                        series_out.push(ProfileSeries {
-                            label: format!("σxx, {}, {} elements", series_label(m, ppc), c.elements),
-                            points: rows
-                                .iter()
-                                .filter(|r| r.len() > 5)
-                                .map(|r| (r[5], r[1]))
-                                .collect(),
-                        });
-                    }
-                }
-                curves.push(ProfileSeries {
-                    label: "analytical σxx = σyy (derived; eq 54)".into(),
-                    points: exact.profile.iter().map(|r| (r[3], r[1])).collect(),
-                });
-            }
-            plot::profile_svg(
-                &fig.title,
-                if plastic {
-                    "Cauchy stress σzz, σxx (Pa)"
-                } else {
-                    "vertical Cauchy stress σzz (Pa)"
-                },
-                "current height z (m)",
-                &series_out,
-                &curves,
-            )
-            .map_err(file_err)
-        }
-        FigureKind::Convergence => {
-            let measure = fig.measure.unwrap_or(Measure::StressError);
-            let mut out = vec![];
-            for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {
-                let pts: Vec<(f64, f64)> = series(&results.cases, ids, m, fig.weight, ppc)
-                    .iter()
-                    .filter_map(|c| case_error(c, measure).map(|e| (c.elements as f64, e)))
-                    .collect();
-                if pts.is_empty() {
-                    continue;
-                }
-                out.push(ConvergenceSeries {
-                    label: series_label(m, ppc),
-                    points: pts,
-                    slope: fitted(results, &fig.sweep, m, fig.weight, ppc, measure),
-                });
-            }
-            plot::convergence_svg(&fig.title, measure.label(), &out, fig.slope_triangles).map_err(file_err)
-        }
-    }
-}
-
-/// Render the report and every figure of the study in `study_dir` from its `results.json`.
-/// Returns the files written.
-pub fn render_study(study_dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
-    let results = read_results(study_dir)?;
-    let mut written = vec![];
-    let p = study_dir.join(&results.study.report_file);
-    crate::study::store::write_file(&p, report_markdown(&results).as_bytes())?;
-    written.push(p);
-    for fig in &results.study.figures {
-        let svg = render_figure(&results, study_dir, fig)?;
-        let p = study_dir.join(format!("{}.svg", fig.id));
-        crate::study::store::write_file(&p, svg.as_bytes())?;
-        written.push(p);
-    }
-    Ok(written)
-}
-
-/// Write `<out>/index.md` linking the report and figures of every study folder in `out` that
-/// holds a `results.json`.
-pub fn render_index(out: &Path) -> Result<PathBuf, StudyError> {
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(out)
-        .map_err(|e| StudyError::io(out, e))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.join("results.json").is_file())
-        .collect();
-    dirs.sort();
-    let mut s = String::from(
-        "# Reports\n\nGenerated by `cargo run --release --bin study -- all`; every file here is \
-         regenerated by the study runner, never edited by hand.\n\n",
-    );
-    for d in dirs {
-        if let Some(entry) = crate::study::registry::index_entry(&d)? {
-            s.push_str(&entry.markdown());
-            continue;
-        }
-        let results = read_results(&d)?;
-        let name = &results.study.name;
-        let (pass, fail, none) = results.check_counts();
-        let _ = writeln!(s, "## {name}\n\n{}\n", results.study.summary);
-        let _ = writeln!(
-            s,
-            "Tier: {}; checks: {pass} passed, {fail} failed, {none} not evaluated.\n",
-            match results.tier {
-                crate::study::Tier::Full => "full",
-                crate::study::Tier::Quick => "quick",
-            }
-        );
-        let _ = writeln!(s, "- [tables]({name}/{})", results.study.report_file);
-        let _ = writeln!(
-            s,
-            "- [results.json]({name}/results.json) and per-case point files in `{name}/points/`"
-        );
-        if d.join("vtk").is_dir() {
-            let _ = writeln!(
-                s,
-                "- ParaView files (`study {name} --vtk`): `{name}/vtk/<case>.pvd`"
-            );
-        }
-        s.push('\n');
-        for f in &results.study.figures {
-            let _ = writeln!(s, "### {}\n\n![{}]({name}/{}.svg)\n", f.title, f.title, f.id);
-        }
-    }
-    let p = out.join("index.md");
-    crate::study::store::write_file(&p, s.as_bytes())?;
-    Ok(p)
 }

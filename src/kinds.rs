@@ -1,0 +1,183 @@
+//! The registry of study kinds: which kind a study file or a results folder holds (its
+//! `problem` key) and the kind's solve, render and index functions. It sits above
+//! [`crate::study`] and [`crate::render`], which do not know it. Adding a kind is its problem
+//! (`src/problems/<x>.rs`), its study kind (`src/study/<x>/`), its render file
+//! (`src/render/<x>.rs`) and one line in [`KINDS`].
+
+use crate::render::{self, IndexEntry};
+use crate::study::cantilever::CantileverStudy;
+use crate::study::column::StudySpec;
+use crate::study::compaction::CompactionStudy;
+use crate::study::engine::{self, RunOptions, StudyKind};
+use crate::study::results::{problem_of_results, problem_of_study, RunSummary};
+use crate::study::{StudyError, Tier};
+use std::path::{Path, PathBuf};
+
+/// Every study kind.
+pub const KINDS: &[Kind] = &[
+    Kind::of::<StudySpec>(render::column::render, render::column::index_entry),
+    Kind::of::<CompactionStudy>(render::compaction::render, render::compaction::index_entry),
+    Kind::of::<CantileverStudy>(render::cantilever::render, render::cantilever::index_entry),
+];
+
+/// What `study` asks of one study file.
+pub struct Request<'a> {
+    pub text: &'a str,
+    /// The file as shown in errors.
+    pub shown: &'a str,
+    /// The file name recorded in results.json.
+    pub file_name: &'a str,
+    pub tier: Tier,
+    pub out: &'a Path,
+    pub render_only: bool,
+}
+
+/// Parse, solve (unless `render_only`) and write a study file: its folder and summary.
+type RunFn =
+    for<'a, 'b> fn(&Request<'a>, RunOptions<'b>) -> Result<(PathBuf, Option<RunSummary>), StudyError>;
+
+/// (name, summary) of a study file's text (and the file as shown), for `study list`.
+type CatalogueFn = fn(&str, &str) -> Result<(String, String), StudyError>;
+
+/// One registered kind: its `problem` key and what `study` does with it.
+pub struct Kind {
+    pub problem: &'static str,
+    run: RunFn,
+    catalogue: CatalogueFn,
+    render: fn(&Path) -> Result<Vec<PathBuf>, StudyError>,
+    index: fn(&Path) -> Result<IndexEntry, StudyError>,
+}
+
+impl Kind {
+    const fn of<K: StudyKind>(
+        render: fn(&Path) -> Result<Vec<PathBuf>, StudyError>,
+        index: fn(&Path) -> Result<IndexEntry, StudyError>,
+    ) -> Kind {
+        Kind {
+            problem: K::PROBLEM,
+            run: run_kind::<K>,
+            catalogue: catalogue_of::<K>,
+            render,
+            index,
+        }
+    }
+}
+
+fn catalogue_of<K: StudyKind>(text: &str, shown: &str) -> Result<(String, String), StudyError> {
+    K::parse(text, shown).map(|s| (s.name().to_string(), s.summary().to_string()))
+}
+
+fn run_kind<K: StudyKind>(
+    r: &Request<'_>,
+    options: RunOptions<'_>,
+) -> Result<(PathBuf, Option<RunSummary>), StudyError> {
+    let study = K::parse(r.text, r.shown)?;
+    let dir = r.out.join(study.name());
+    if r.render_only {
+        return Ok((dir, None));
+    }
+    let options = RunOptions {
+        study_dir: Some(dir.clone()),
+        ..options
+    };
+    let run = engine::run(&study, r.file_name, r.tier, &options)?;
+    engine::write_outputs(r.out, &run)?;
+    Ok((dir, Some(run.results.summary(run.resumed))))
+}
+
+/// The kind of `problem`, or an error naming the study file's `problem` key and the kinds.
+pub fn kind(problem: &str, shown: &str) -> Result<&'static Kind, StudyError> {
+    KINDS.iter().find(|k| k.problem == problem).ok_or_else(|| {
+        let known: Vec<&str> = KINDS.iter().map(|k| k.problem).collect();
+        StudyError::Invalid {
+            file: shown.to_string(),
+            key: "problem".into(),
+            value: format!("{problem:?}"),
+            allowed: format!("must be one of {}", known.join(", ")),
+        }
+    })
+}
+
+/// Solve (unless `render_only`) and render the study in `file`, with the case store,
+/// `--resume`, `--vtk`, `--shard`/`--merge` and progress of `options` (its `study_dir` is set
+/// here: `<out>/<name>`). Returns the study's output folder, its summary (none with
+/// `render_only`) and the rendered files.
+pub fn run_file(
+    file: &Path,
+    tier: Tier,
+    out: &Path,
+    render_only: bool,
+    options: RunOptions<'_>,
+) -> Result<(PathBuf, Option<RunSummary>, Vec<PathBuf>), StudyError> {
+    let text = std::fs::read_to_string(file).map_err(|e| StudyError::io(file, e))?;
+    let shown = file.display().to_string();
+    let problem = problem_of_study(&text).unwrap_or_default();
+    let k = kind(&problem, &shown).map_err(|e| {
+        match crate::study::vocabulary::parse_toml::<toml::Value>(&text, &shown) {
+            Err(parse) => parse,
+            Ok(_) => e,
+        }
+    })?;
+    let file_name = file.file_name().map_or_else(
+        || file.display().to_string(),
+        |f| f.to_string_lossy().into_owned(),
+    );
+    let request = Request {
+        text: &text,
+        shown: &shown,
+        file_name: &file_name,
+        tier,
+        out,
+        render_only,
+    };
+    let (dir, summary) = (k.run)(&request, options)?;
+    let files = render_dir(&dir)?;
+    Ok((dir, summary, files))
+}
+
+fn kind_of_results(dir: &Path) -> Result<&'static Kind, StudyError> {
+    let shown = dir.join("results.json").display().to_string();
+    match problem_of_results(dir) {
+        Some(p) => kind(&p, &shown),
+        None => Err(StudyError::io(
+            &dir.join("results.json"),
+            "missing or unreadable (no study.problem): solve the study first",
+        )),
+    }
+}
+
+/// Render the tables and figures of a study folder from its results.
+pub fn render_dir(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+    (kind_of_results(dir)?.render)(dir)
+}
+
+/// The index entry of a study folder.
+pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
+    (kind_of_results(dir)?.index)(dir)
+}
+
+/// Write `<out>/index.md` linking the reports and figures of every study folder in `out`
+/// that holds a `results.json`.
+pub fn render_index(out: &Path) -> Result<PathBuf, StudyError> {
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(out)
+        .map_err(|e| StudyError::io(out, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("results.json").is_file())
+        .collect();
+    dirs.sort();
+    let entries = dirs
+        .iter()
+        .map(|d| index_entry(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let p = out.join("index.md");
+    crate::study::store::write_file(&p, render::index_page(&entries).as_bytes())?;
+    Ok(p)
+}
+
+/// (name, summary) of a study file for `study list`.
+pub fn catalogue_entry(file: &Path) -> Result<(String, String), StudyError> {
+    let text = std::fs::read_to_string(file).map_err(|e| StudyError::io(file, e))?;
+    let shown = file.display().to_string();
+    let k = kind(&problem_of_study(&text).unwrap_or_default(), &shown)?;
+    (k.catalogue)(&text, &shown)
+}

@@ -1,0 +1,259 @@
+//! The cantilever as a study kind: one case is the beam solved by one method
+//! ([`crate::problems::cantilever::solve`]); its record carries the end displacement after
+//! every step against the elastica, and the domain snapshots of the figures' cases go to
+//! `domains.json`.
+
+use super::{CantileverCase, CantileverStudy};
+use crate::method::Method;
+use crate::mpm::{DomainUpdate, VolumeUpdate};
+use crate::problems::cantilever::{solve, CantileverSpec, DomainSnapshot, EndDisplacement};
+use crate::problems::elastica::{bending_stiffness, Elastica};
+use crate::study::compaction::kind::CaseDefinition;
+use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
+use crate::study::results::{
+    case_record, write_json, CaseStatus, FailureRecord, SolveRecord, StepRecord, SweepIndex,
+};
+use crate::study::store::case_hash;
+use crate::study::vtk_output::{write_domain_frames, DomainFrame};
+use crate::study::{StudyError, Tier};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The elastica at one load: the end displacement in the model's axes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ElasticaPoint {
+    pub load: f64,
+    /// α = PL²/EI.
+    pub alpha: f64,
+    pub u_over_l: f64,
+    /// −(deflection in the load direction)/L.
+    pub v_over_l: f64,
+}
+
+/// The elastica load path of one beam.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ElasticaPath {
+    pub plane_strain: bool,
+    pub bending_stiffness: f64,
+    pub points: Vec<ElasticaPoint>,
+}
+
+pub(super) fn elastica_path(spec: &CantileverSpec, plane_strain: bool) -> Option<ElasticaPath> {
+    let ei = bending_stiffness(spec.young_modulus, spec.poisson_ratio, spec.depth, plane_strain).ok()?;
+    let beam = Elastica::try_new(spec.length, ei).ok()?;
+    let loads = crate::problems::elastica::load_steps(spec.load, spec.load_steps);
+    let tips = beam.load_path(&loads).ok()?;
+    Some(ElasticaPath {
+        plane_strain,
+        bending_stiffness: ei,
+        points: loads
+            .iter()
+            .zip(tips)
+            .map(|(&load, t)| ElasticaPoint {
+                load,
+                alpha: t.alpha,
+                u_over_l: t.u_over_l,
+                v_over_l: -t.v_over_l,
+            })
+            .collect(),
+    })
+}
+
+/// Result of one case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CantileverRecord {
+    pub id: String,
+    pub method: Method,
+    pub domain_update: Option<DomainUpdate>,
+    pub volume_update: Option<VolumeUpdate>,
+    pub depth: f64,
+    pub load: f64,
+    pub element_size: f64,
+    pub load_steps: usize,
+    pub status: CaseStatus,
+    pub failure: Option<FailureRecord>,
+    /// End displacement (mean of the two loaded points) after each converged step.
+    pub end: Vec<EndDisplacement>,
+    /// Final u/L and v/L (converged cases only).
+    pub u_over_l: Option<f64>,
+    pub v_over_l: Option<f64>,
+    /// Plane-strain elastica of this beam at the full load, and the relative differences
+    /// (continuum − elastica)/|elastica|.
+    pub elastica: Option<ElasticaPoint>,
+    pub difference_u: Option<f64>,
+    pub difference_v: Option<f64>,
+    /// Initial domain half-length and the smallest half-length after each converged step.
+    pub initial_half_length: f64,
+    pub min_half_length: Vec<f64>,
+    /// Indices of the two loaded points in the domain snapshots.
+    pub loaded_points: Option<[usize; 2]>,
+    pub newton_iterations: usize,
+    pub steps: Vec<StepRecord>,
+}
+
+/// One row of the depth study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DepthRow {
+    pub case: String,
+    pub elements_through_depth: i64,
+    pub depth: f64,
+    pub load: f64,
+    pub element_size: f64,
+    pub u_over_l: Option<f64>,
+    pub v_over_l: Option<f64>,
+    pub difference_u: Option<f64>,
+    pub difference_v: Option<f64>,
+}
+
+/// The cantilever's measures in `results.json`: the elastica and the depth study.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CantileverMeasures {
+    /// Plane strain first, then plane stress when asked for.
+    pub elastica: Vec<ElasticaPath>,
+    pub depth_study: Vec<DepthRow>,
+}
+
+/// `results.json` of the cantilever study.
+pub type CantileverResults = Results<CantileverStudy>;
+
+case_record!(CantileverRecord);
+
+/// Solve one case, taking domain snapshots every `snapshot_every` steps (0: none).
+fn solve_case_snapshots(
+    case: &CantileverCase,
+    snapshot_every: usize,
+) -> (CantileverRecord, Vec<DomainSnapshot>) {
+    let s = &case.spec;
+    let igimp = case.method == Method::Igimp;
+    let (solved, o) = match solve(s, case.method, snapshot_every) {
+        Err(e) => (SolveRecord::rejected(e), None),
+        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
+    };
+    let elastica = elastica_path(s, true).and_then(|p| p.points.last().copied());
+    let (end, min_half_length, loaded_points, mut snaps) = match o {
+        Some(o) => (o.end, o.min_half_length, o.loaded_points, o.snapshots),
+        None => (vec![], vec![], None, vec![]),
+    };
+    let last = end.last().filter(|_| solved.status == CaseStatus::Converged);
+    let (u, v) = (last.map(|e| e.u_over_l), last.map(|e| e.v_over_l));
+    let relative = |x: Option<f64>, e: Option<f64>| Some((x? - e?) / e?.abs());
+    let rec = CantileverRecord {
+        id: case.id.clone(),
+        method: case.method,
+        domain_update: igimp.then_some(s.domain_update),
+        volume_update: igimp.then_some(s.volume_update),
+        depth: s.depth,
+        load: s.load,
+        element_size: s.element_size,
+        load_steps: s.load_steps,
+        status: solved.status,
+        failure: solved.failure,
+        end,
+        u_over_l: u,
+        v_over_l: v,
+        elastica,
+        difference_u: relative(u, elastica.map(|e| e.u_over_l)),
+        difference_v: relative(v, elastica.map(|e| e.v_over_l)),
+        initial_half_length: 0.5 * s.element_size / s.points_per_cell as f64,
+        min_half_length,
+        loaded_points,
+        newton_iterations: solved.newton_iterations,
+        steps: solved.steps,
+    };
+    // Keep one snapshot per step (a failing step repeats the last converged state).
+    snaps.dedup_by_key(|s| s.step);
+    (rec, snaps)
+}
+
+impl StudyKind for CantileverStudy {
+    const PROBLEM: &'static str = "cantilever";
+    type Case = CantileverCase;
+    type Output = (CantileverRecord, Vec<DomainSnapshot>);
+    type Record = CantileverRecord;
+    type Measures = CantileverMeasures;
+
+    study_file_fields!();
+    fn cases(&self, tier: Tier) -> (Vec<CantileverCase>, SweepIndex) {
+        (self.cases(tier), SweepIndex::new())
+    }
+    fn key(&self, c: &CantileverCase) -> CaseKey {
+        CaseKey {
+            id: c.id.clone(),
+            hash: case_hash(&CaseDefinition {
+                id: &c.id,
+                method: c.method,
+                spec: &c.spec,
+                snapshot_every: c.snapshot_every,
+            }),
+            has_vtk: c.method.uses_material_points(),
+        }
+    }
+    fn cost(&self, c: &CantileverCase) -> f64 {
+        (c.spec.length / c.spec.element_size) * (c.spec.points_per_cell as f64).powi(2)
+    }
+    /// With `--vtk` every iGIMP case takes snapshots: its figure's interval, else
+    /// `--vtk-every`, else only the initial and final states.
+    fn solve(&self, c: &CantileverCase, vtk: Option<&VtkTarget>) -> Result<Self::Output, StudyError> {
+        let every = match vtk {
+            Some(v) if c.snapshot_every == 0 => {
+                if v.options.every > 0 {
+                    v.options.every
+                } else {
+                    c.spec.load_steps
+                }
+            }
+            _ => c.snapshot_every,
+        };
+        let out = solve_case_snapshots(c, every);
+        if let Some(v) = vtk {
+            write_case_vtk(&v.study_dir, c, &out)?;
+        }
+        Ok(out)
+    }
+    fn record(o: &Self::Output) -> &CantileverRecord {
+        &o.0
+    }
+    fn measure(results: &mut Results<Self>) {
+        let study = &results.study;
+        let base = study.base_spec();
+        let mut elastica: Vec<ElasticaPath> = elastica_path(&base, true).into_iter().collect();
+        if study.plane_stress_elastica {
+            elastica.extend(elastica_path(&base, false));
+        }
+        results.measures = CantileverMeasures {
+            elastica,
+            depth_study: super::checks::depth_rows(study, &results.cases),
+        };
+        results.checks = super::checks::compute_checks(results);
+    }
+    /// `domains.json`: the snapshots of the cases a figure draws (`snapshot_every` > 0).
+    fn write_side_files(&self, dir: &Path, outputs: &[Self::Output]) -> Result<(), StudyError> {
+        let drawn: BTreeMap<&str, &Vec<DomainSnapshot>> = outputs
+            .iter()
+            .filter(|(r, s)| !s.is_empty() && self.cases.iter().any(|c| c.id == r.id && c.snapshot_every > 0))
+            .map(|(r, s)| (r.id.as_str(), s))
+            .collect();
+        write_json(&dir.join("domains.json"), &drawn, false)
+    }
+}
+
+/// ParaView files of an iGIMP case: its domain snapshots (the initial state, every
+/// `--vtk-every` steps or the figure's interval, and the last converged step).
+fn write_case_vtk(
+    dir: &Path,
+    case: &CantileverCase,
+    out: &(CantileverRecord, Vec<DomainSnapshot>),
+) -> Result<(), StudyError> {
+    let frames: Vec<DomainFrame> = out
+        .1
+        .iter()
+        .map(|s| DomainFrame {
+            time: s.step as f64 / case.spec.load_steps.max(1) as f64,
+            step: s.step,
+            domains: s.domains.clone(),
+            scalars: vec![],
+        })
+        .collect();
+    write_domain_frames(dir, &case.id, &frames).map(|_| ())
+}

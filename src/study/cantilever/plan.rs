@@ -1,0 +1,209 @@
+//! Validation and planning of a cantilever study file: the `[[cases]]` and the depth study's
+//! cases (P ∝ depth³, h ∝ depth) of a tier.
+
+use super::{CantileverCase, CantileverFigureKind, CantileverStudy, CaseSection};
+use crate::problems::cantilever::{CantileverSpec, METHODS};
+use crate::study::vocabulary::{max_points_per_axis, Checker, Header};
+use crate::study::{StudyError, Tier};
+use std::collections::BTreeSet;
+
+impl CantileverStudy {
+    pub(super) fn check(&self, file: &str) -> Result<(), StudyError> {
+        let chk = Checker { file };
+        chk.header(Header {
+            schema: self.schema,
+            problem: &self.problem,
+            expected_problem: "cantilever",
+            name: &self.name,
+            summary: &self.summary,
+            report_file: &self.report_file,
+        })?;
+        let b = &self.beam;
+        chk.count("beam.load_steps", b.load_steps, 1, 10_000)?;
+        chk.count(
+            "beam.points_per_cell",
+            b.points_per_cell,
+            1,
+            max_points_per_axis(2),
+        )?;
+        chk.newton("newton", &self.newton)?;
+        let mut ids = BTreeSet::new();
+        for (i, c) in self.cases.iter().enumerate() {
+            chk.unique_ident(&format!("cases[{i}].id"), &c.id, &mut ids)?;
+            c.method
+                .expect_one_of("cantilever", &METHODS)
+                .map_err(|e| chk.err(format!("cases[{i}].method"), c.method.name(), e.allowed))?;
+            chk.count(&format!("cases[{i}].snapshot_every"), c.snapshot_every, 0, 10_000)?;
+        }
+        if self.cases.is_empty() {
+            return Err(chk.err("cases", "[]", "must list at least one case"));
+        }
+        self.ghost
+            .validate()
+            .map_err(|e| chk.err("ghost", e, "must be valid ghost settings"))?;
+        for (i, c) in self.cases.iter().enumerate() {
+            self.case_of(c)
+                .spec
+                .validate()
+                .map_err(|e| chk.err(format!("cases[{i}]"), e, "must be a valid cantilever input"))?;
+        }
+        let known = |key: String, id: &str| -> Result<(), StudyError> {
+            if self.cases.iter().any(|c| c.id == id) {
+                Ok(())
+            } else {
+                Err(chk.err(key, id, "must name a case"))
+            }
+        };
+        if let Some(d) = &self.depth_study {
+            known("depth_study.case".into(), &d.case)?;
+            if let Some(&x) = d.depths.iter().find(|&&x| !(x.is_finite() && x > 0.0)) {
+                return Err(chk.err("depth_study.depths", x, "must be finite and > 0"));
+            }
+            if d.elements_through_depth.is_empty()
+                || d.elements_through_depth
+                    .iter()
+                    .any(|&n| !(2..=64).contains(&n) || n % 2 != 0)
+            {
+                return Err(chk.err(
+                    "depth_study.elements_through_depth",
+                    format!("{:?}", d.elements_through_depth),
+                    "must list even integers in 2..=64",
+                ));
+            }
+        }
+        for (i, e) in self.expect_completes.iter().enumerate() {
+            known(format!("expect_completes[{i}].case"), &e.case)?;
+        }
+        for (i, e) in self.expect_elastica.iter().enumerate() {
+            known(format!("expect_elastica[{i}].case"), &e.case)?;
+        }
+        for (i, e) in self.expect_agreement.iter().enumerate() {
+            known(format!("expect_agreement[{i}].case"), &e.case)?;
+            known(format!("expect_agreement[{i}].reference"), &e.reference)?;
+        }
+        for (i, e) in self.expect_collapse.iter().enumerate() {
+            known(format!("expect_collapse[{i}].case"), &e.case)?;
+            if !(e.fraction > 0.0 && e.fraction < 1.0) || e.window < 2 {
+                return Err(chk.err(
+                    format!("expect_collapse[{i}]"),
+                    &e.case,
+                    "fraction must lie in (0, 1) and window be >= 2",
+                ));
+            }
+        }
+        let mut fig_ids = BTreeSet::new();
+        for (i, f) in self.figures.iter().enumerate() {
+            chk.unique_ident(&format!("figures[{i}].id"), &f.id, &mut fig_ids)?;
+            for c in &f.cases {
+                known(format!("figures[{i}].cases"), c)?;
+            }
+            if f.kind == CantileverFigureKind::Domains && f.cases.len() != 1 {
+                return Err(chk.err(
+                    format!("figures[{i}].cases"),
+                    f.cases.len(),
+                    "domain figures draw exactly one case",
+                ));
+            }
+        }
+        for (c, _) in self.all_cases() {
+            c.spec
+                .validate()
+                .map_err(|e| chk.err(format!("case {}", c.id), e, "must be a valid cantilever input"))?;
+        }
+        Ok(())
+    }
+}
+
+impl CantileverStudy {
+    pub(super) fn base_spec(&self) -> CantileverSpec {
+        let b = &self.beam;
+        CantileverSpec {
+            length: b.length,
+            depth: b.depth,
+            young_modulus: b.young_modulus,
+            poisson_ratio: b.poisson_ratio,
+            load: b.load,
+            load_steps: b.load_steps.max(1) as usize,
+            element_size: b.element_size,
+            points_per_cell: b.points_per_cell.max(1) as usize,
+            grid_below: b.grid_below,
+            grid_margin: b.grid_margin,
+            newton: self.newton.settings(),
+            weak_node_tolerance: self.weak_nodes.tolerance,
+            weak_node_treatment: self.weak_nodes.treatment,
+            ghost: self
+                .ghost
+                .settings(b.points_per_cell.max(1) as usize, false, None),
+            ..CantileverSpec::default()
+        }
+    }
+
+    fn case_of(&self, c: &CaseSection) -> CantileverCase {
+        CantileverCase {
+            id: c.id.clone(),
+            method: c.method,
+            spec: {
+                let base = self.base_spec();
+                CantileverSpec {
+                    domain_update: c.domain_update.unwrap_or(base.domain_update),
+                    volume_update: c.volume_update.unwrap_or(base.volume_update),
+                    ghost: self.ghost.settings(base.points_per_cell, false, c.ghost_gamma),
+                    weak_node_tolerance: c.weak_node_tolerance.unwrap_or(base.weak_node_tolerance),
+                    ..base
+                }
+            },
+            snapshot_every: c.snapshot_every.max(0) as usize,
+        }
+    }
+
+    /// Elements through the beam's own depth.
+    fn base_elements_through_depth(&self) -> i64 {
+        (self.beam.depth / self.beam.element_size).round() as i64
+    }
+
+    /// The depth-study case at `depth` with `n` elements through it: P scaled by (depth/d0)³,
+    /// h = depth / n.
+    fn depth_case(&self, base: &CantileverCase, depth: f64, n: i64) -> CantileverCase {
+        let ratio = depth / self.beam.depth;
+        CantileverCase {
+            id: format!("{}-depth{depth}-n{n}", base.id),
+            method: base.method,
+            spec: CantileverSpec {
+                depth,
+                load: base.spec.load * ratio.powi(3),
+                element_size: depth / n.max(1) as f64,
+                ..base.spec
+            },
+            snapshot_every: 0,
+        }
+    }
+
+    /// Every case (with its full-only flag) in file order, depth-study cases last.
+    fn all_cases(&self) -> Vec<(CantileverCase, bool)> {
+        let mut out: Vec<(CantileverCase, bool)> = self
+            .cases
+            .iter()
+            .map(|c| (self.case_of(c), c.full_only))
+            .collect();
+        if let Some(d) = &self.depth_study {
+            if let Some((base, full_only)) = out.iter().find(|(c, _)| c.id == d.case).cloned() {
+                for &n in &d.elements_through_depth {
+                    let own = (n != self.base_elements_through_depth()).then_some(self.beam.depth);
+                    for &depth in own.iter().chain(&d.depths) {
+                        out.push((self.depth_case(&base, depth, n), full_only || d.full_only));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The cases of a tier.
+    pub fn cases(&self, tier: Tier) -> Vec<CantileverCase> {
+        self.all_cases()
+            .into_iter()
+            .filter(|(_, full_only)| tier == Tier::Full || !full_only)
+            .map(|(c, _)| c)
+            .collect()
+    }
+}

@@ -1,0 +1,213 @@
+//! The compaction's measures and checks: the Figure 17 reference (Richardson-extrapolated
+//! FEM, else the finest FEM mesh, else the finest iGIMP case) and the study file's
+//! expectations (deviation, convergence, weak-node and ghost spreads).
+
+use super::kind::{CompactionRecord, CompactionResults, ReferenceRecord};
+use crate::method::Method;
+use crate::study::checks::{check_at_most, relative_spread, richardson, CheckRecord};
+use crate::study::vocabulary::number;
+use std::collections::BTreeSet;
+
+pub(super) fn figure17_reference(results: &CompactionResults) -> Option<ReferenceRecord> {
+    let mut fem: Vec<&CompactionRecord> = results
+        .sweep(&results.study.reference.fem_sweep)
+        .into_iter()
+        .filter(|c| c.method.is_fem() && c.max_horizontal_displacement.is_some())
+        .collect();
+    fem.sort_by(|a, b| b.h.total_cmp(&a.h));
+    if let Some(finest) = fem.last() {
+        let n = fem.len();
+        let u = |c: &CompactionRecord| c.max_horizontal_displacement.unwrap_or(f64::NAN);
+        if n >= 3 {
+            let (a, b, c) = (fem[n - 3], fem[n - 2], fem[n - 1]);
+            let r = a.h / b.h;
+            if ((b.h / c.h) - r).abs() < 1e-9 * r {
+                if let Some((limit, p)) = richardson([u(a), u(b), u(c)], r) {
+                    return Some(ReferenceRecord {
+                        value: limit,
+                        method: finest.method,
+                        cases: vec![a.id.clone(), b.id.clone(), c.id.clone()],
+                        observed_order: Some(p),
+                        description: format!(
+                            "{} extrapolated from h = {}, {}, {} (observed order {p:.2})",
+                            finest.method.label(),
+                            a.h,
+                            b.h,
+                            c.h
+                        ),
+                    });
+                }
+            }
+        }
+        return Some(ReferenceRecord {
+            value: u(finest),
+            method: finest.method,
+            cases: vec![finest.id.clone()],
+            observed_order: None,
+            description: format!("finest {} mesh, h = {}", finest.method.label(), finest.h),
+        });
+    }
+    let finest = results
+        .sweep(&results.study.reference.igimp_sweep)
+        .into_iter()
+        .filter(|c| c.method == Method::Igimp && c.max_horizontal_displacement.is_some())
+        .min_by(|a, b| {
+            a.h.total_cmp(&b.h)
+                .then(b.points_per_cell.cmp(&a.points_per_cell))
+        })?;
+    Some(ReferenceRecord {
+        value: finest.max_horizontal_displacement?,
+        method: Method::Igimp,
+        cases: vec![finest.id.clone()],
+        observed_order: None,
+        description: format!(
+            "finest iGIMP case (h = {}, {}×{} points per cell): the study has no converged FEM reference sweep",
+            finest.h,
+            finest.points_per_cell.unwrap_or(0),
+            finest.points_per_cell.unwrap_or(0)
+        ),
+    })
+}
+
+pub(super) fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
+    let mut out = vec![];
+    let reference = results.measures.reference.as_ref().map(|r| r.value);
+    let igimp = |sweep: &str| -> Vec<&CompactionRecord> {
+        results
+            .sweep(sweep)
+            .into_iter()
+            .filter(|c| c.method == Method::Igimp && c.max_horizontal_displacement.is_some())
+            .collect()
+    };
+    let deviation = |c: &CompactionRecord| -> Option<f64> {
+        Some((c.max_horizontal_displacement? / reference? - 1.0).abs())
+    };
+    let against = results
+        .measures
+        .reference
+        .as_ref()
+        .map_or("no reference".into(), |r| r.description.clone());
+    for e in &results.study.expect_deviation {
+        let devs: Vec<f64> = igimp(&e.sweep)
+            .into_iter()
+            .filter(|c| c.h <= e.max_element_size)
+            .filter_map(deviation)
+            .collect();
+        let measured = (!devs.is_empty()).then(|| devs.iter().copied().fold(0.0, f64::max));
+        out.push(check_at_most(
+            &format!(
+                "{}-within-{}pc-h{}",
+                e.sweep,
+                100.0 * e.tolerance,
+                e.max_element_size
+            ),
+            format!(
+                "largest abs(u/u_ref − 1) over the {} completed iGIMP cases with h ≤ {} (u_ref: {against})",
+                devs.len(),
+                e.max_element_size
+            ),
+            measured,
+            e.tolerance,
+            &e.source,
+        ));
+    }
+    for e in &results.study.expect_convergence {
+        let cases = igimp(&e.sweep);
+        let ppcs: BTreeSet<usize> = cases.iter().filter_map(|c| c.points_per_cell).collect();
+        let mut worst: Option<f64> = None;
+        let mut series = 0;
+        for p in ppcs {
+            let mut s: Vec<&CompactionRecord> = cases
+                .iter()
+                .copied()
+                .filter(|c| c.points_per_cell == Some(p) && results.is_default(c))
+                .collect();
+            s.sort_by(|a, b| b.h.total_cmp(&a.h));
+            let d: Vec<f64> = s.iter().filter_map(|c| deviation(c)).collect();
+            if d.len() >= 2 {
+                series += 1;
+                for w in d.windows(2) {
+                    let growth = w[1] - w[0];
+                    worst = Some(worst.map_or(growth, |x: f64| x.max(growth)));
+                }
+            }
+        }
+        out.push(check_at_most(
+            &format!("{}-converges", e.sweep),
+            format!(
+                "largest growth of abs(u/u_ref − 1) from one element size to the next smaller, over {series} points-per-cell series (u_ref: {against})"
+            ),
+            worst,
+            e.slack,
+            &e.source,
+        ));
+    }
+    for e in &results.study.expect_weak_node_spread {
+        let cases: Vec<&CompactionRecord> = igimp(&e.sweep)
+            .into_iter()
+            .filter(|c| c.weak_node_tolerance > 0.0)
+            .collect();
+        let hs: BTreeSet<u64> = cases.iter().map(|c| c.h.to_bits()).collect();
+        let mut worst: Option<f64> = None;
+        for h in hs {
+            let u: Vec<f64> = cases
+                .iter()
+                .filter(|c| c.h.to_bits() == h)
+                .filter_map(|c| c.max_horizontal_displacement)
+                .collect();
+            if let Some(spread) = relative_spread(&u) {
+                worst = Some(worst.map_or(spread, |w: f64| w.max(spread)));
+            }
+        }
+        out.push(check_at_most(
+            &format!("{}-weak-node-spread", e.sweep),
+            "largest (max − min)/min of the displacement over the non-zero weak-node tolerances at one element size".into(),
+            worst,
+            e.tolerance,
+            &e.source,
+        ));
+    }
+    for e in &results.study.expect_ghost_spread {
+        let cases: Vec<&CompactionRecord> = igimp(&e.sweep)
+            .into_iter()
+            .filter(|c| c.ghost_gamma > 0.0 && c.h <= e.max_element_size)
+            .collect();
+        let keys: BTreeSet<(u64, Option<usize>)> =
+            cases.iter().map(|c| (c.h.to_bits(), c.points_per_cell)).collect();
+        let mut worst: Option<f64> = None;
+        let mut gammas: BTreeSet<u64> = BTreeSet::new();
+        let mut incomplete = 0;
+        for k in keys {
+            let group: Vec<&&CompactionRecord> = cases
+                .iter()
+                .filter(|c| (c.h.to_bits(), c.points_per_cell) == k)
+                .collect();
+            gammas.extend(group.iter().map(|c| c.ghost_gamma.to_bits()));
+            let u: Vec<f64> = group
+                .iter()
+                .filter_map(|c| c.max_horizontal_displacement)
+                .collect();
+            incomplete += group.len() - u.len();
+            if let Some(spread) = relative_spread(&u) {
+                worst = Some(worst.map_or(spread, |w: f64| w.max(spread)));
+            }
+        }
+        let (g_lo, g_hi) = gammas
+            .iter()
+            .map(|&b| f64::from_bits(b))
+            .fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
+        out.push(check_at_most(
+            &format!("{}-ghost-spread", e.sweep),
+            format!(
+                "largest (max − min)/min of the displacement over ghost γ in [{}, {}] at one element size ≤ {} ({incomplete} case(s) not completed count as a failure)",
+                number(g_lo),
+                number(g_hi),
+                e.max_element_size
+            ),
+            if incomplete > 0 { Some(f64::INFINITY) } else { worst },
+            e.tolerance,
+            &e.source,
+        ));
+    }
+    out
+}

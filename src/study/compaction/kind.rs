@@ -1,0 +1,250 @@
+//! The compaction as a study kind: one case is the block solved by one method
+//! ([`crate::problems::compaction::solve`]); its record carries Figure 17's measure and the
+//! Newton histories, and the domains of the drawn cases go to `domains.json`.
+
+use super::{CompactionCase, CompactionFigureKind, CompactionStudy};
+use crate::method::Method;
+use crate::problems::compaction::{solve, DomainRecord};
+use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
+use crate::study::results::{
+    case_record, write_json, CaseStatus, FailureRecord, SolveRecord, StepRecord, SweepIndex,
+};
+use crate::study::store::case_hash;
+use crate::study::vtk_output::{write_domain_frames, DomainFrame};
+use crate::study::{StudyError, Tier};
+use serde::{Deserialize, Serialize};
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+/// Result of one case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CompactionRecord {
+    pub id: String,
+    pub method: Method,
+    /// Element size h.
+    pub h: f64,
+    /// Points per element along each axis; `None` (null) for FEM.
+    pub points_per_cell: Option<usize>,
+    pub yield_stress: Option<f64>,
+    pub weak_node_tolerance: f64,
+    /// Ghost penalty factor γ of the case (0: off; FEM: 0).
+    pub ghost_gamma: f64,
+    /// Faces carrying the ghost penalty (`cut` or `all`).
+    pub ghost_faces: crate::ghost::GhostFaces,
+    /// Load steps that needed cutbacks, and the failed attempts in all.
+    pub steps_cut: usize,
+    pub cutbacks: usize,
+    pub status: CaseStatus,
+    pub failure: Option<FailureRecord>,
+    /// Bottom-right point's horizontal displacement plus half its domain's growth (Figure 17);
+    /// converged cases only.
+    pub max_horizontal_displacement: Option<f64>,
+    /// The same measure at the last converged step of a failed case.
+    pub last_converged_displacement: Option<f64>,
+    /// Weak-node constraints applied, summed over the load steps.
+    pub weak_nodes_treated: usize,
+    /// Material points (iGIMP) or elements (FEM).
+    pub points: usize,
+    pub newton_iterations: usize,
+    pub steps: Vec<StepRecord>,
+}
+
+/// The value Figure 17 is normalised by.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceRecord {
+    pub value: f64,
+    pub method: Method,
+    /// The case(s) it comes from.
+    pub cases: Vec<String>,
+    /// Observed convergence order when Richardson-extrapolated.
+    pub observed_order: Option<f64>,
+    /// One sentence for captions and the report.
+    pub description: String,
+}
+
+/// The compaction's measures in `results.json`: the Figure 17 reference.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CompactionMeasures {
+    pub reference: Option<ReferenceRecord>,
+}
+
+/// `results.json` of the compaction study.
+pub type CompactionResults = Results<CompactionStudy>;
+
+case_record!(CompactionRecord);
+
+impl CompactionResults {
+    /// The iGIMP case of a sweep at (h, points per cell) with the study's weak-node tolerance.
+    pub fn igimp_case(&self, sweep: &str, h: f64, ppc: usize) -> Option<&CompactionRecord> {
+        self.sweep(sweep).into_iter().find(|c| {
+            c.method == Method::Igimp && c.h == h && c.points_per_cell == Some(ppc) && self.is_default(c)
+        })
+    }
+
+    /// Does the case use the study's default treatment of nearly empty cells (weak-node
+    /// tolerance and ghost γ)? FEM cases always do.
+    pub fn is_default(&self, c: &CompactionRecord) -> bool {
+        match c.points_per_cell {
+            None => true,
+            Some(p) => {
+                c.weak_node_tolerance == self.study.weak_nodes.tolerance
+                    && c.ghost_gamma == self.study.ghost.settings(p, c.yield_stress.is_some(), None).gamma
+            }
+        }
+    }
+}
+
+fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
+    let s = &case.spec;
+    let (solved, o) = match solve(s, case.method) {
+        Err(e) => (SolveRecord::rejected(e), None),
+        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
+    };
+    let u = o.as_ref().and_then(|o| {
+        let u = o.max_horizontal_displacement;
+        u.is_finite().then_some(u)
+    });
+    let converged = solved.status == CaseStatus::Converged;
+    let steps = o.as_ref().map_or(&[][..], |o| &o.steps[..]);
+    let rec = CompactionRecord {
+        id: case.id.clone(),
+        method: case.method,
+        h: s.element_size,
+        points_per_cell: (!case.method.is_fem()).then_some(s.points_per_cell),
+        yield_stress: s.yield_stress,
+        weak_node_tolerance: s.weak_node_tolerance,
+        ghost_gamma: if case.method.is_fem() { 0.0 } else { s.ghost.gamma },
+        ghost_faces: s.ghost.faces,
+        steps_cut: steps.iter().filter(|s| s.cutbacks() > 0).count(),
+        cutbacks: steps.iter().map(|s| s.cutbacks()).sum(),
+        status: solved.status,
+        failure: solved.failure,
+        max_horizontal_displacement: u.filter(|_| converged),
+        last_converged_displacement: u.filter(|_| solved.status == CaseStatus::Failed),
+        weak_nodes_treated: o.as_ref().map_or(0, |o| o.weak_nodes_treated),
+        points: o.as_ref().map_or(0, |o| o.size),
+        newton_iterations: solved.newton_iterations,
+        steps: solved.steps,
+    };
+    (rec, o.map_or(vec![], |o| o.domains))
+}
+
+/// The inputs that define a plane-strain case's result, hashed for `--resume`.
+#[derive(Serialize)]
+pub(crate) struct CaseDefinition<'a, S> {
+    pub id: &'a str,
+    pub method: Method,
+    pub spec: &'a S,
+    /// Domain snapshots taken for the figures (0: none).
+    pub snapshot_every: usize,
+}
+
+impl StudyKind for CompactionStudy {
+    const PROBLEM: &'static str = "compaction";
+    type Case = CompactionCase;
+    type Output = (CompactionRecord, Vec<DomainRecord>);
+    type Record = CompactionRecord;
+    type Measures = CompactionMeasures;
+
+    study_file_fields!();
+    fn cases(&self, tier: Tier) -> (Vec<CompactionCase>, SweepIndex) {
+        self.cases(tier)
+    }
+    fn key(&self, c: &CompactionCase) -> CaseKey {
+        CaseKey {
+            id: c.id.clone(),
+            hash: case_hash(&CaseDefinition {
+                id: &c.id,
+                method: c.method,
+                spec: &c.spec,
+                snapshot_every: 0,
+            }),
+            has_vtk: c.method.uses_material_points(),
+        }
+    }
+    fn cost(&self, c: &CompactionCase) -> f64 {
+        let s = &c.spec;
+        (s.points_per_cell * s.points_per_cell) as f64 / (s.element_size * s.element_size)
+    }
+    fn solve(&self, c: &CompactionCase, vtk: Option<&VtkTarget>) -> Result<Self::Output, StudyError> {
+        let out = solve_case(c);
+        if let Some(v) = vtk {
+            write_case_vtk(&v.study_dir, c, &out)?;
+        }
+        Ok(out)
+    }
+    fn record(o: &Self::Output) -> &CompactionRecord {
+        &o.0
+    }
+    fn measure(results: &mut Results<Self>) {
+        results.measures.reference = super::checks::figure17_reference(results);
+        results.checks = super::checks::compute_checks(results);
+    }
+    /// `domains.json`: the final domains of the cases the domain figures draw.
+    fn write_side_files(&self, dir: &Path, outputs: &[Self::Output]) -> Result<(), StudyError> {
+        let drawn = self.drawn_cases();
+        let domains: BTreeMap<&str, &Vec<DomainRecord>> = outputs
+            .iter()
+            .filter(|(r, _)| drawn.contains(&r.id))
+            .map(|(r, d)| (r.id.as_str(), d))
+            .collect();
+        write_json(&dir.join("domains.json"), &domains, false)
+    }
+}
+
+impl CompactionStudy {
+    /// Ids of the iGIMP cases a domain figure draws.
+    fn drawn_cases(&self) -> BTreeSet<String> {
+        self.figures
+            .iter()
+            .filter(|f| f.kind == CompactionFigureKind::Domains)
+            .filter_map(|f| {
+                let s = self.sweeps.iter().find(|s| s.id == f.sweep)?;
+                let spec = self.case_spec(
+                    s,
+                    f.element_size?,
+                    f.points_per_cell? as usize,
+                    self.weak_nodes.tolerance,
+                    None,
+                );
+                Some(self.case_id(Method::Igimp, &spec))
+            })
+            .collect()
+    }
+}
+
+/// ParaView files of an iGIMP case: the initial domains and those of the last converged step
+/// (σyy and the plastic multiplier as cell data).
+fn write_case_vtk(
+    dir: &Path,
+    case: &CompactionCase,
+    out: &(CompactionRecord, Vec<DomainRecord>),
+) -> Result<(), StudyError> {
+    let (rec, doms) = out;
+    let initial = DomainFrame {
+        time: 0.0,
+        step: 0,
+        domains: doms
+            .iter()
+            .map(|d| [d.x0[0], d.x0[1], d.half0[0], d.half0[1]])
+            .collect(),
+        scalars: vec![],
+    };
+    let steps = rec.steps.len();
+    let last = DomainFrame {
+        time: steps as f64 / case.spec.load_steps.max(1) as f64,
+        step: steps,
+        domains: doms
+            .iter()
+            .map(|d| [d.x[0], d.x[1], d.half[0], d.half[1]])
+            .collect(),
+        scalars: vec![
+            ("sigma_yy".into(), doms.iter().map(|d| d.sigma_yy).collect()),
+            (
+                "plastic_multiplier".into(),
+                doms.iter().map(|d| d.plastic_multiplier).collect(),
+            ),
+        ],
+    };
+    write_domain_frames(dir, &case.id, &[initial, last]).map(|_| ())
+}

@@ -1,0 +1,334 @@
+//! The one study engine. A study kind ([`StudyKind`]) says how its study file is checked, which
+//! cases a tier has, how one case is solved and what its measures and checks are; the engine
+//! does the rest for every kind alike: rayon across cases (most expensive first, results in
+//! the deterministic case order, so the output does not depend on the thread count), the case
+//! store (`<out>/<name>/cases/`, every finished case written atomically as soon as it is done),
+//! `--resume` by input hash, `--vtk`, the progress callbacks, `--shard K/N` and `--merge`, and
+//! the [`Envelope`] written as `results.json`.
+//!
+//! A failed case is recorded in its record (status, step, reason, residuals) and the others go
+//! on; only an I/O error of the store stops a run (the first in case order).
+
+use super::checks::CheckRecord;
+use super::results::{
+    read_results, write_json, CaseRecordOf, CaseStatus, Envelope, Provenance, SweepIndex, Timing,
+};
+use super::store::CaseStore;
+use super::vtk_output::{pvd_path, VtkOptions};
+use super::{Distribution, StudyError, Tier};
+use rayon::prelude::*;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+/// The store key of a case: its id, the hash of the inputs that define its result
+/// ([`super::store::case_hash`]), and whether it writes ParaView files.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CaseKey {
+    pub id: String,
+    pub hash: String,
+    pub has_vtk: bool,
+}
+
+/// Where and what a case writes for ParaView (`--vtk`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct VtkTarget {
+    /// The study's output folder (files go to its `vtk/`).
+    pub study_dir: PathBuf,
+    pub options: VtkOptions,
+}
+
+/// One kind of study: a problem's study file and how its cases are planned, solved, measured
+/// and checked.
+pub trait StudyKind: Serialize + DeserializeOwned + Clone + Sync {
+    /// The `problem` key of the kind's study files (and of `study.problem` in its results).
+    const PROBLEM: &'static str;
+    /// One case to solve.
+    type Case: Sync;
+    /// What the case store keeps of a solved case: its record and any side data.
+    type Output: Send + Serialize + DeserializeOwned;
+    /// A case's entry in `results.json`.
+    type Record: Clone + CaseRecordOf + Serialize + DeserializeOwned;
+    /// The kind's measures besides the checks (flattened into `results.json`).
+    type Measures: Clone + Default + Serialize + DeserializeOwned;
+
+    /// Check every value of the parsed file; errors name `file`, the key and the allowed range.
+    fn validate(&self, file: &str) -> Result<(), StudyError>;
+    /// The study's `name` (its output folder).
+    fn name(&self) -> &str;
+    /// One line for `study list`.
+    fn summary(&self) -> &str;
+    /// Every distinct case of the tier in file order (the order shards split) and the case
+    /// ids of each sweep.
+    fn cases(&self, tier: Tier) -> (Vec<Self::Case>, SweepIndex);
+    fn key(&self, case: &Self::Case) -> CaseKey;
+    /// Relative cost, so that the expensive cases start first.
+    fn cost(&self, case: &Self::Case) -> f64;
+    /// Solve one case; with `vtk`, also write its ParaView files.
+    fn solve(&self, case: &Self::Case, vtk: Option<&VtkTarget>) -> Result<Self::Output, StudyError>;
+    fn record(output: &Self::Output) -> &Self::Record;
+    /// Fill the measures and checks of `results`, whose cases are solved.
+    fn measure(results: &mut Results<Self>);
+    /// Write the files beside `results.json` (e.g. drawn domains, point files) into `dir`.
+    fn write_side_files(&self, dir: &Path, outputs: &[Self::Output]) -> Result<(), StudyError>;
+
+    /// Parse and validate a study file's text; `file` names it in errors.
+    fn parse(text: &str, file: &str) -> Result<Self, StudyError> {
+        let spec: Self = super::vocabulary::parse_toml(text, file)?;
+        spec.validate(file)?;
+        Ok(spec)
+    }
+
+    /// Read, parse and validate a study file.
+    fn load(path: &Path) -> Result<Self, StudyError> {
+        let text = std::fs::read_to_string(path).map_err(|e| StudyError::io(path, e))?;
+        Self::parse(&text, &path.display().to_string())
+    }
+}
+
+/// The [`StudyKind`] methods of a study file with `name` and `summary` fields whose
+/// inherent `check(&self, file)` validates it.
+macro_rules! study_file_fields {
+    () => {
+        fn validate(&self, file: &str) -> Result<(), $crate::study::StudyError> {
+            self.check(file)
+        }
+        fn name(&self) -> &str {
+            &self.name
+        }
+        fn summary(&self) -> &str {
+            &self.summary
+        }
+    };
+}
+pub(crate) use study_file_fields;
+
+/// `results.json` of study kind `K`.
+pub type Results<K> = Envelope<K, <K as StudyKind>::Record, <K as StudyKind>::Measures>;
+
+/// A solved study: the results, each case's output (case order), and how many were read back
+/// from the case store.
+pub struct Run<K: StudyKind> {
+    pub results: Results<K>,
+    pub outputs: Vec<K::Output>,
+    pub resumed: usize,
+}
+
+/// What a run asks besides the tier: the case store, `--resume`, `--vtk`, `--shard`/`--merge`
+/// and the progress callbacks.
+pub struct RunOptions<'a> {
+    /// The study's output folder; `None`: no case store and no VTK (an in-memory run).
+    pub study_dir: Option<PathBuf>,
+    /// Reuse the stored record of a case whose inputs hash equally.
+    pub resume: bool,
+    /// Write ParaView files of the cases that have them.
+    pub vtk: Option<VtkOptions>,
+    /// `--shard K/N` or `--merge` (needs `study_dir`).
+    pub distribution: Distribution,
+    /// Called once with the number of cases, then with each case's id and status when done.
+    pub on_start: &'a (dyn Fn(usize) + Sync),
+    pub on_done: &'a (dyn Fn(&str, CaseStatus) + Sync),
+}
+
+impl Default for RunOptions<'_> {
+    fn default() -> Self {
+        Self {
+            study_dir: None,
+            resume: false,
+            vtk: None,
+            distribution: Distribution::Whole,
+            on_start: &|_| {},
+            on_done: &|_, _| {},
+        }
+    }
+}
+
+/// Solve `cases` on the rayon pool, most expensive first (by `cost`), and return the results
+/// in the order of `cases` with each one's wall seconds.
+pub fn run_cases<C: Sync, R: Send>(
+    cases: &[C],
+    cost: impl Fn(&C) -> f64 + Sync,
+    solve: impl Fn(&C) -> R + Sync,
+) -> Vec<(R, f64)> {
+    let mut order: Vec<usize> = (0..cases.len()).collect();
+    order.sort_by(|&a, &b| cost(&cases[b]).total_cmp(&cost(&cases[a])).then(a.cmp(&b)));
+    let mut solved: Vec<(usize, R, f64)> = order
+        .par_iter()
+        .map(|&i| {
+            let t = Instant::now();
+            let r = solve(&cases[i]);
+            (i, r, t.elapsed().as_secs_f64())
+        })
+        .collect();
+    solved.sort_by_key(|s| s.0);
+    solved.into_iter().map(|(_, r, t)| (r, t)).collect()
+}
+
+/// A finished case as the store keeps it: its output and the seconds it took (so that a
+/// resumed run reports the original timing).
+#[derive(Serialize, Deserialize)]
+struct StoredCase<R> {
+    output: R,
+    seconds: f64,
+}
+
+/// Each case's output with its wall seconds, and how many were read back from the store.
+type Solved<K> = (Vec<(<K as StudyKind>::Output, f64)>, usize);
+/// A case's output and, if read back from the store, the seconds it originally took.
+type Finished<K> = (<K as StudyKind>::Output, Option<f64>);
+
+/// Solve (or read back) every case this process owns: with `resume` (or `--merge`), a case
+/// stored earlier under the same id and input hash (with `--vtk`, whose `.pvd` exists too) is
+/// read back instead of solved; every solved case is stored as soon as it is done. Returns
+/// the outputs in case order with their seconds, and how many were resumed. `--merge` solves
+/// nothing and lists every case not in the store in one error; `--shard` stores its cases and
+/// ends with [`StudyError::ShardDone`].
+fn solve_all<K: StudyKind>(
+    study: &K,
+    cases: &[K::Case],
+    options: &RunOptions<'_>,
+) -> Result<Solved<K>, StudyError> {
+    let store = match &options.study_dir {
+        Some(dir) => Some(CaseStore::open(&dir.join("cases"))?),
+        None => None,
+    };
+    let distribution = options.distribution;
+    let merge = distribution == Distribution::Merge;
+    let resume = options.resume || merge;
+    let own: Vec<&K::Case> = cases
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| distribution.owns(*i))
+        .map(|(_, c)| c)
+        .collect();
+    (options.on_start)(own.len());
+    let resumed = AtomicUsize::new(0);
+    let done = |id: &str, o: &K::Output| (options.on_done)(id, K::record(o).status());
+    let outputs = run_cases(
+        &own,
+        |c| study.cost(c),
+        |c| -> Result<Option<Finished<K>>, StudyError> {
+            let key = study.key(c);
+            let (Some(store), Some(dir)) = (&store, &options.study_dir) else {
+                let o = study.solve(c, None)?;
+                done(&key.id, &o);
+                return Ok(Some((o, None)));
+            };
+            // --merge solves nothing, so it does not ask for the VTK files either.
+            let vtk_done = match options.vtk {
+                Some(_) if key.has_vtk && !merge => pvd_path(dir, &key.id)?.exists(),
+                _ => true,
+            };
+            if resume && vtk_done {
+                if let Some(s) = store.load::<StoredCase<K::Output>>(&key.id, &key.hash) {
+                    resumed.fetch_add(1, Ordering::Relaxed);
+                    done(&key.id, &s.output);
+                    return Ok(Some((s.output, Some(s.seconds))));
+                }
+            }
+            if merge {
+                return Ok(None);
+            }
+            let vtk = options.vtk.filter(|_| key.has_vtk).map(|options| VtkTarget {
+                study_dir: dir.clone(),
+                options,
+            });
+            let t = Instant::now();
+            let output = study.solve(c, vtk.as_ref())?;
+            let seconds = t.elapsed().as_secs_f64();
+            let stored = StoredCase { output, seconds };
+            store.save(&key.id, &key.hash, &stored)?;
+            done(&key.id, &stored.output);
+            Ok(Some((stored.output, Some(seconds))))
+        },
+    );
+    let mut out = Vec::with_capacity(outputs.len());
+    let mut missing = vec![];
+    for (c, (r, secs)) in own.iter().zip(outputs) {
+        match r? {
+            Some((o, stored_secs)) => out.push((o, stored_secs.unwrap_or(secs))),
+            None => missing.push(study.key(c).id),
+        }
+    }
+    if let (false, Some(dir)) = (missing.is_empty(), &options.study_dir) {
+        return Err(StudyError::MissingCases {
+            dir: dir.join("cases").display().to_string(),
+            total: cases.len(),
+            missing,
+        });
+    }
+    if let (Distribution::Shard { k, n }, Some(dir)) = (distribution, &options.study_dir) {
+        return Err(StudyError::ShardDone {
+            k,
+            n,
+            solved: out.len(),
+            total: cases.len(),
+            dir: dir.join("cases").display().to_string(),
+        });
+    }
+    Ok((out, resumed.into_inner()))
+}
+
+/// Solve every case of the tier with `options`, then measure and check: the run of `study`
+/// whose study file is `study_file` (its name, recorded in the results).
+pub fn run<K: StudyKind>(
+    study: &K,
+    study_file: &str,
+    tier: Tier,
+    options: &RunOptions<'_>,
+) -> Result<Run<K>, StudyError> {
+    let start = Instant::now();
+    let (cases, sweep_cases) = study.cases(tier);
+    let (solved, resumed) = solve_all(study, &cases, options)?;
+    let mut times = std::collections::BTreeMap::new();
+    let mut records = Vec::with_capacity(solved.len());
+    let mut outputs = Vec::with_capacity(solved.len());
+    for (o, secs) in solved {
+        let r = K::record(&o).clone();
+        times.insert(r.id().to_string(), secs);
+        records.push(r);
+        outputs.push(o);
+    }
+    let mut results = Envelope {
+        provenance: Provenance::new(study_file, tier),
+        study: study.clone(),
+        sweep_cases,
+        cases: records,
+        measures: K::Measures::default(),
+        checks: Vec::<CheckRecord>::new(),
+        timing: Timing {
+            wall_seconds: 0.0,
+            threads: rayon::current_num_threads(),
+            cases: times,
+        },
+    };
+    K::measure(&mut results);
+    results.timing.wall_seconds = start.elapsed().as_secs_f64();
+    Ok(Run {
+        results,
+        outputs,
+        resumed,
+    })
+}
+
+/// [`run`] in memory: no case store, no VTK, no progress.
+pub fn run_in_memory<K: StudyKind>(study: &K, study_file: &str, tier: Tier) -> Result<Run<K>, StudyError> {
+    run(study, study_file, tier, &RunOptions::default())
+}
+
+/// Write `<out>/<name>/results.json` and the kind's side files; returns the folder.
+pub fn write_outputs<K: StudyKind>(out: &Path, run: &Run<K>) -> Result<PathBuf, StudyError> {
+    let study = &run.results.study;
+    let dir = out.join(study.name());
+    std::fs::create_dir_all(&dir).map_err(|e| StudyError::io(&dir, e))?;
+    study.write_side_files(&dir, &run.outputs)?;
+    write_json(&dir.join("results.json"), &run.results, true)?;
+    Ok(dir)
+}
+
+/// Read the `results.json` of a kind-`K` study folder.
+pub fn read<K: StudyKind>(dir: &Path) -> Result<Results<K>, StudyError> {
+    read_results(dir)
+}

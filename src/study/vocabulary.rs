@@ -1,0 +1,299 @@
+//! The one validation vocabulary of every study file: the identifier rule, the limits, the
+//! [`Checker`] whose errors name the file, the key, the value and the allowed range, and the
+//! sections several kinds share (`[newton]`, `[weak_nodes]`, `[ghost]`).
+
+use super::{StudyError, SCHEMA_VERSION};
+use crate::mpm::WeakNodeTreatment;
+use crate::newton::NewtonSettings;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeSet;
+
+/// Newton settings as written in a study file.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NewtonSection {
+    /// Converged when ‖f_int − f_ext‖ / ‖f_ext‖ ≤ tolerance; in (0, 1).
+    pub tolerance: f64,
+    /// Most Newton iterations per load step; 1..=1000.
+    pub max_iterations: i64,
+    /// Backtracking line search (default off: plain Newton as in the paper).
+    #[serde(default)]
+    pub line_search: bool,
+    /// `external` (‖f_ext‖ over the free dofs, the default), `total` (‖f_ext + f_reaction‖
+    /// over all dofs, exact reactions) or `linearised` (the paper's Tables 2–3: reactions
+    /// updated by their linearised increment, their out-of-balance in the numerator).
+    #[serde(default)]
+    pub residual_norm: crate::newton::ResidualNorm,
+    /// Adaptive load stepping: most halvings of a failing increment (0..=20, default 6:
+    /// down to 1/64 of a load step; 0 = fixed steps).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_cutbacks: Option<u32>,
+}
+
+impl NewtonSection {
+    pub fn settings(&self) -> NewtonSettings {
+        NewtonSettings {
+            tolerance: self.tolerance,
+            max_iterations: self.max_iterations as usize,
+            line_search: self.line_search,
+            residual_norm: self.residual_norm,
+            max_cutbacks: self.max_cutbacks.unwrap_or(crate::newton::DEFAULT_CUTBACKS),
+        }
+    }
+}
+
+/// Weak-node treatment as written in a study file (see [`crate::mpm::MpmSettings`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WeakNodeSection {
+    /// Nodes whose material volume share is below this fraction of an element are treated;
+    /// in [0, 1), 0 disables the treatment.
+    pub tolerance: f64,
+    pub treatment: WeakNodeTreatment,
+}
+
+/// Ghost stabilisation as written in a study file ([`crate::ghost`]): γ and the faces for
+/// two or more points per cell, the settings for one point per cell (every face), and those
+/// of plastic cases.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GhostSection {
+    /// Penalty factor γ for two or more points per cell (0 = off); in [0, 1000].
+    pub gamma: f64,
+    #[serde(default)]
+    pub faces: crate::ghost::GhostFaces,
+    /// Fill fraction below which a cell is cut, in (0, 1]; default
+    /// [`crate::ghost::DEFAULT_CUT_FILL`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cut_fill: Option<f64>,
+    /// Settings for one point per cell; default: the ones above.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub one_point_per_cell: Option<crate::ghost::GhostSettings>,
+    /// Settings for plastic (von Mises) cases with two or more points per cell; default: the
+    /// ones above.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plastic: Option<crate::ghost::GhostSettings>,
+    /// Where the defaults come from (the measurement that chose them).
+    pub source: String,
+}
+
+impl GhostSection {
+    /// The settings of a case with `ppc` points per cell, plastic or not; `gamma` (a sweep's
+    /// value) replaces the default γ.
+    pub fn settings(&self, ppc: usize, plastic: bool, gamma: Option<f64>) -> crate::ghost::GhostSettings {
+        let mut g = match (ppc, self.one_point_per_cell, plastic, self.plastic) {
+            (1, Some(one), _, _) => one,
+            (_, _, true, Some(p)) => p,
+            _ => crate::ghost::GhostSettings {
+                gamma: self.gamma,
+                faces: self.faces,
+                cut_fill: self.cut_fill.unwrap_or(crate::ghost::DEFAULT_CUT_FILL),
+            },
+        };
+        if let Some(gamma) = gamma {
+            g.gamma = gamma;
+        }
+        g
+    }
+
+    pub fn validate(&self) -> Result<(), crate::error::InputError> {
+        self.settings(2, false, None).validate()?;
+        self.settings(2, true, None).validate()?;
+        self.settings(1, false, None).validate()
+    }
+}
+
+/// The one identifier rule of every study file (names, sweep, case and figure ids, report
+/// files): [`IDENT_RULE`]. The leading letter or digit and the ban on `..` keep hidden and
+/// parent paths out, so that an identifier used as a folder or file name stays inside the
+/// output folder.
+pub fn ident_ok(s: &str) -> bool {
+    !s.is_empty()
+        && s.len() <= 64
+        && s.as_bytes()[0].is_ascii_alphanumeric()
+        && !s.contains("..")
+        && s.bytes()
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || matches!(b, b'-' | b'_' | b'.'))
+}
+
+/// [`ident_ok`] in words, for error messages.
+pub const IDENT_RULE: &str =
+    "1-64 characters from [a-z0-9_.-], starting with a letter or digit, without \"..\"";
+
+/// Most material points per cell of a study case in any dimension (per axis: 64 in 1D, 8 in
+/// 2D, 4 in 3D): beyond it a point's share of a cell is below the quadrature's round-off.
+pub const MAX_POINTS_PER_CELL: i64 = 64;
+
+/// Largest points per cell along each axis in `dim` dimensions ([`MAX_POINTS_PER_CELL`]).
+pub fn max_points_per_axis(dim: u32) -> i64 {
+    (1..=MAX_POINTS_PER_CELL)
+        .take_while(|n| n.pow(dim) <= MAX_POINTS_PER_CELL)
+        .last()
+        .unwrap_or(1)
+}
+
+/// Format a weight for case ids and labels without a trailing `.0`.
+pub fn weight_label(w: f64) -> String {
+    if w.fract() == 0.0 && w.abs() < 1e15 {
+        format!("{}", w as i64)
+    } else {
+        format!("{w}")
+    }
+}
+
+/// A float as written in an error: scientific notation when very large or small.
+pub fn short(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e15).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
+}
+
+/// A number in a case id or label: shortest round-trip form.
+pub fn number(x: f64) -> String {
+    format!("{x}")
+}
+
+/// Validation of one study file: every error names the file, the key, the value and the
+/// allowed range.
+pub struct Checker<'a> {
+    pub file: &'a str,
+}
+
+impl Checker<'_> {
+    pub fn err(
+        &self,
+        key: impl Into<String>,
+        value: impl ToString,
+        allowed: impl Into<String>,
+    ) -> StudyError {
+        StudyError::Invalid {
+            file: self.file.to_string(),
+            key: key.into(),
+            value: value.to_string(),
+            allowed: allowed.into(),
+        }
+    }
+    pub fn count(&self, key: &str, v: i64, lo: i64, hi: i64) -> Result<(), StudyError> {
+        if (lo..=hi).contains(&v) {
+            Ok(())
+        } else {
+            Err(self.err(key, v, format!("must be an integer in {lo}..={hi}")))
+        }
+    }
+    pub fn positive(&self, key: &str, v: f64) -> Result<(), StudyError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(self.err(key, short(v), "must be finite and > 0"))
+        }
+    }
+    pub fn ident(&self, key: &str, v: &str) -> Result<(), StudyError> {
+        if ident_ok(v) {
+            Ok(())
+        } else {
+            Err(self.err(key, format!("{v:?}"), format!("must be {IDENT_RULE}")))
+        }
+    }
+    pub fn text(&self, key: &str, v: &str) -> Result<(), StudyError> {
+        if v.trim().is_empty() {
+            Err(self.err(key, "\"\"", "must not be empty"))
+        } else {
+            Ok(())
+        }
+    }
+    pub fn non_empty<T>(&self, key: &str, v: &[T]) -> Result<(), StudyError> {
+        if v.is_empty() {
+            Err(self.err(key, "[]", "must list at least one value"))
+        } else {
+            Ok(())
+        }
+    }
+    /// An identifier unique among those `seen` so far (which it joins).
+    pub fn unique_ident<'s>(
+        &self,
+        key: &str,
+        v: &'s str,
+        seen: &mut BTreeSet<&'s str>,
+    ) -> Result<(), StudyError> {
+        if ident_ok(v) && seen.insert(v) {
+            Ok(())
+        } else {
+            Err(self.err(
+                key,
+                format!("{v:?}"),
+                format!("must be a unique identifier ({IDENT_RULE})"),
+            ))
+        }
+    }
+    /// A Markdown file name `<identifier>.md`.
+    pub fn markdown_file(&self, key: &str, v: &str) -> Result<(), StudyError> {
+        if v.ends_with(".md") && ident_ok(v.trim_end_matches(".md")) {
+            Ok(())
+        } else {
+            Err(self.err(
+                key,
+                format!("{v:?}"),
+                format!("must be a file name <identifier>.md ({IDENT_RULE})"),
+            ))
+        }
+    }
+    /// The keys every study file starts with: `schema`, `problem`, `name`, `summary` and
+    /// `report_file`.
+    pub fn header(&self, h: Header<'_>) -> Result<(), StudyError> {
+        if h.schema != SCHEMA_VERSION {
+            return Err(self.err("schema", h.schema, format!("must be {SCHEMA_VERSION}")));
+        }
+        if h.problem != h.expected_problem {
+            return Err(self.err(
+                "problem",
+                format!("{:?}", h.problem),
+                format!("must be {:?}", h.expected_problem),
+            ));
+        }
+        self.ident("name", h.name)?;
+        self.text("summary", h.summary)?;
+        self.markdown_file("report_file", h.report_file)
+    }
+    pub fn newton(&self, key: &str, n: &NewtonSection) -> Result<(), StudyError> {
+        if !(n.tolerance.is_finite() && n.tolerance > 0.0 && n.tolerance < 1.0) {
+            return Err(self.err(format!("{key}.tolerance"), n.tolerance, "must lie in (0, 1)"));
+        }
+        self.count(&format!("{key}.max_iterations"), n.max_iterations, 1, 1000)
+    }
+}
+
+/// The keys every study file starts with, for [`Checker::header`].
+pub struct Header<'a> {
+    pub schema: i64,
+    pub problem: &'a str,
+    pub expected_problem: &'a str,
+    pub name: &'a str,
+    pub summary: &'a str,
+    pub report_file: &'a str,
+}
+
+/// A value outside its allowed range in a study file.
+pub fn invalid(
+    file: &str,
+    key: impl Into<String>,
+    value: impl ToString,
+    allowed: impl Into<String>,
+) -> StudyError {
+    StudyError::Invalid {
+        file: file.to_string(),
+        key: key.into(),
+        value: value.to_string(),
+        allowed: allowed.into(),
+    }
+}
+
+/// Parse a study file's TOML into `T` (unknown keys are errors through `deny_unknown_fields`).
+pub fn parse_toml<T: DeserializeOwned>(text: &str, file: &str) -> Result<T, StudyError> {
+    toml::from_str(text).map_err(|e| StudyError::Parse {
+        file: file.to_string(),
+        message: e.to_string().trim_end().to_string(),
+    })
+}
