@@ -2,7 +2,6 @@
 //! and `domains.json` only.
 
 use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, PointMarks, XyAxes, XySeries};
-use crate::problems::cantilever::DomainSnapshot;
 use crate::study::cantilever::*;
 type Results = CantileverResults;
 use super::{checks_markdown, failures_markdown, IndexEntry};
@@ -269,16 +268,12 @@ fn render_figure(
 pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
     let results: Results = read_results(dir)?;
     let snapshots: BTreeMap<String, Vec<DomainSnapshot>> = read_json(&dir.join("domains.json"))?;
-    let figures =
-        results.study.figures.iter().map(|f| {
-            render_figure(&results, &snapshots, dir, f).map(|svg| svg.map(|svg| (f.id.clone(), svg)))
-        });
-    super::write_files(
-        dir,
-        (&results.study.report_file, report_markdown(&results)),
-        std::iter::empty(),
-        figures,
-    )
+    let mut files = super::Files::new(dir);
+    files.text(&results.study.report_file, &report_markdown(&results))?;
+    for f in &results.study.figures {
+        files.figure(&f.id, render_figure(&results, &snapshots, dir, f)?)?;
+    }
+    Ok(files.written)
 }
 
 pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {

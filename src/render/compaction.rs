@@ -2,11 +2,9 @@
 //! `results.json` and `domains.json` only.
 
 use crate::method::Method;
-use crate::newton::ResidualNorm;
 use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, XyAxes, XySeries};
-use crate::problems::compaction::DomainRecord;
 use crate::study::compaction::*;
-use crate::study::vocabulary::number;
+use crate::study::vocabulary::{number, GhostFaces, ResidualNorm};
 type Results = CompactionResults;
 use super::{checks_markdown, failures_markdown, IndexEntry};
 use crate::study::checks::check_counts;
@@ -173,7 +171,7 @@ fn cases_table(results: &CompactionResults) -> String {
             c.weak_node_tolerance,
             if c.method.is_fem() {
                 "—".into()
-            } else if c.ghost_gamma > 0.0 && c.ghost_faces == crate::ghost::GhostFaces::All {
+            } else if c.ghost_gamma > 0.0 && c.ghost_faces == GhostFaces::All {
                 format!("{} (all faces)", number(c.ghost_gamma))
             } else {
                 number(c.ghost_gamma)
@@ -398,22 +396,15 @@ type SeriesKey = (Method, Option<usize>);
 pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
     let results: Results = read_results(dir)?;
     let domains: BTreeMap<String, Vec<DomainRecord>> = read_json(&dir.join("domains.json"))?;
-    let tables = results
-        .study
-        .paper_residuals
-        .iter()
-        .map(|p| (p.file.clone(), residual_table(&results, p)));
-    let figures = results
-        .study
-        .figures
-        .iter()
-        .map(|f| render_figure(&results, &domains, dir, f).map(|svg| svg.map(|svg| (f.id.clone(), svg))));
-    super::write_files(
-        dir,
-        (&results.study.report_file, report_markdown(&results)),
-        tables,
-        figures,
-    )
+    let mut files = super::Files::new(dir);
+    files.text(&results.study.report_file, &report_markdown(&results))?;
+    for p in &results.study.paper_residuals {
+        files.text(&p.file, &residual_table(&results, p))?;
+    }
+    for f in &results.study.figures {
+        files.figure(&f.id, render_figure(&results, &domains, dir, f)?)?;
+    }
+    Ok(files.written)
 }
 
 pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {

@@ -41,25 +41,26 @@ fn index_header(name: &str, summary: &str, tier: Tier, checks: (usize, usize, us
     )
 }
 
-/// Write a study's rendered files into `dir`: the report, its extra tables (file, text) and
-/// one SVG per figure that has something to draw (id, svg); the files written, in that order.
-pub(crate) fn write_files(
-    dir: &Path,
-    report: (&str, String),
-    tables: impl IntoIterator<Item = (String, String)>,
-    figures: impl IntoIterator<Item = Result<Option<(String, String)>, StudyError>>,
-) -> Result<Vec<PathBuf>, StudyError> {
-    let mut written = vec![];
-    write_text(&dir.join(report.0), &report.1, &mut written)?;
-    for (file, text) in tables {
-        write_text(&dir.join(file), &text, &mut written)?;
+/// The files a renderer writes into a study folder, in order (atomically, each noted).
+pub(crate) struct Files<'a> {
+    dir: &'a Path,
+    pub written: Vec<PathBuf>,
+}
+
+impl<'a> Files<'a> {
+    pub fn new(dir: &'a Path) -> Self {
+        Files { dir, written: vec![] }
     }
-    for f in figures {
-        if let Some((id, svg)) = f? {
-            write_text(&dir.join(format!("{id}.svg")), &svg, &mut written)?;
-        }
+
+    /// A Markdown (or other text) file.
+    pub fn text(&mut self, file: &str, text: &str) -> Result<(), StudyError> {
+        write_text(&self.dir.join(file), text, &mut self.written)
     }
-    Ok(written)
+
+    /// `<id>.svg`, if the figure has something to draw.
+    pub fn figure(&mut self, id: &str, svg: Option<String>) -> Result<(), StudyError> {
+        svg.map_or(Ok(()), |svg| self.text(&format!("{id}.svg"), &svg))
+    }
 }
 
 /// The index entry of a plane-strain study: its report, tables (title, file) and figures

@@ -16,6 +16,7 @@ use super::results::{
 use super::store::CaseStore;
 use super::vtk_output::{pvd_path, VtkOptions};
 use super::{Distribution, StudyError, Tier};
+use crate::method::Method;
 use rayon::prelude::*;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -30,6 +31,33 @@ pub struct CaseKey {
     pub id: String,
     pub hash: String,
     pub has_vtk: bool,
+}
+
+/// The inputs that define a case's result, hashed for `--resume`.
+#[derive(Serialize)]
+struct CaseDefinition<'a, S> {
+    id: &'a str,
+    method: Method,
+    spec: &'a S,
+    /// Domain snapshots taken for the figures (0: none).
+    snapshot_every: usize,
+}
+
+impl CaseKey {
+    /// The key of a case defined by its id, method and problem input `spec` (and the
+    /// snapshots its figures take); the material point methods write ParaView files.
+    pub fn of_spec<S: Serialize>(id: &str, method: Method, spec: &S, snapshot_every: usize) -> Self {
+        CaseKey {
+            id: id.to_string(),
+            hash: super::store::case_hash(&CaseDefinition {
+                id,
+                method,
+                spec,
+                snapshot_every,
+            }),
+            has_vtk: method.uses_material_points(),
+        }
+    }
 }
 
 /// Where and what a case writes for ParaView (`--vtk`).

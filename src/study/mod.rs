@@ -5,7 +5,7 @@
 //! Pipeline (compute → JSON → render): [`engine::run`] solves every case of any
 //! [`engine::StudyKind`] (rayon, results in a fixed order, the case store, `--resume`,
 //! `--vtk`, `--shard`/`--merge`) and [`engine::write_outputs`] writes the [`results::Envelope`]
-//! as `results.json`; [`crate::render`] reads only the results files. The kinds: [`column`]
+//! as `results.json`; [`crate::render`] reads only the results files. The kinds: [`column`](mod@column)
 //! (§5.1), [`compaction`] (§5.2), [`cantilever`] (§5.3); [`crate::kinds`] registers them.
 //!
 //! Counts in the files are parsed as signed integers so that a negative value is reported by

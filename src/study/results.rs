@@ -295,6 +295,21 @@ pub fn write_json<T: Serialize>(path: &Path, value: &T, pretty: bool) -> Result<
     super::store::write_file(path, (text + "\n").as_bytes())
 }
 
+/// Write `path` (compact JSON): the side data `D` of the cases whose (record, data) `keep`
+/// accepts, by case id.
+pub fn write_case_data<R: CaseRecordOf, D: Serialize>(
+    path: &Path,
+    outputs: &[(R, D)],
+    keep: impl Fn(&R, &D) -> bool,
+) -> Result<(), StudyError> {
+    let kept: BTreeMap<&str, &D> = outputs
+        .iter()
+        .filter(|(r, d)| keep(r, d))
+        .map(|(r, d)| (r.id(), d))
+        .collect();
+    write_json(path, &kept, false)
+}
+
 pub fn read_json<T: DeserializeOwned>(path: &Path) -> Result<T, StudyError> {
     let text = std::fs::read_to_string(path).map_err(|e| StudyError::io(path, e))?;
     serde_json::from_str(&text).map_err(|e| StudyError::Parse {

@@ -8,7 +8,7 @@
 //! ([`case_hash`]) beside its record; `study --resume` reuses a stored record when the hash
 //! of the case to run matches, and solves the case again otherwise.
 //!
-//! The store is generic over the record type, so every problem's runner can use it.
+//! The store is generic over the record type; [`super::engine`] uses it for every kind.
 
 use super::StudyError;
 pub use crate::atomic_file::write_atomic;

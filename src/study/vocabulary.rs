@@ -3,8 +3,11 @@
 //! sections several kinds share (`[newton]`, `[weak_nodes]`, `[ghost]`).
 
 use super::{StudyError, SCHEMA_VERSION};
-use crate::mpm::WeakNodeTreatment;
+/// Settings the study files (and so `results.json`) hold, for the renderers to read.
+pub use crate::ghost::{GhostFaces, GhostSettings};
+pub use crate::mpm::WeakNodeTreatment;
 use crate::newton::NewtonSettings;
+pub use crate::newton::ResidualNorm;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;

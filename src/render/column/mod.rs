@@ -115,18 +115,12 @@ pub(super) fn pass_word(p: Option<bool>) -> &'static str {
 /// Returns the files written.
 pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
     let results: ColumnResults = read_results(dir)?;
-    let figures: Vec<_> = results
-        .study
-        .figures
-        .iter()
-        .map(|f| render_figure(&results, dir, f).map(|svg| Some((f.id.clone(), svg))))
-        .collect();
-    super::write_files(
-        dir,
-        (&results.study.report_file, report_markdown(&results)),
-        std::iter::empty(),
-        figures,
-    )
+    let mut files = super::Files::new(dir);
+    files.text(&results.study.report_file, &report_markdown(&results))?;
+    for f in &results.study.figures {
+        files.figure(&f.id, Some(render_figure(&results, dir, f)?))?;
+    }
+    Ok(files.written)
 }
 
 /// The column study's section of `reports/index.md`: the report, the results and point

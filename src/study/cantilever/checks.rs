@@ -1,7 +1,7 @@
 //! The cantilever's checks (completion, elastica, agreement, collapse, the depth study) and
 //! the depth study's rows.
 
-use super::kind::{CantileverRecord, CantileverResults, DepthRow};
+use super::records::{CantileverRecord, CantileverResults, DepthRow};
 use super::CantileverStudy;
 use crate::study::checks::{check_at_most, CheckRecord};
 use crate::study::results::CaseStatus;

@@ -3,41 +3,16 @@
 //! every step against the elastica, and the domain snapshots of the figures' cases go to
 //! `domains.json`.
 
+use super::records::{CantileverMeasures, CantileverRecord, ElasticaPath, ElasticaPoint};
 use super::{CantileverCase, CantileverStudy};
 use crate::method::Method;
-use crate::mpm::{DomainUpdate, VolumeUpdate};
-use crate::problems::cantilever::{solve, CantileverSpec, DomainSnapshot, EndDisplacement};
+use crate::problems::cantilever::{solve, CantileverSpec, DomainSnapshot};
 use crate::problems::elastica::{bending_stiffness, Elastica};
-use crate::study::compaction::kind::CaseDefinition;
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
-use crate::study::results::{
-    case_record, write_json, CaseStatus, FailureRecord, SolveRecord, StepRecord, SweepIndex,
-};
-use crate::study::store::case_hash;
+use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};
 use crate::study::vtk_output::{write_domain_frames, DomainFrame};
 use crate::study::{StudyError, Tier};
-use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
 use std::path::Path;
-
-/// The elastica at one load: the end displacement in the model's axes.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct ElasticaPoint {
-    pub load: f64,
-    /// α = PL²/EI.
-    pub alpha: f64,
-    pub u_over_l: f64,
-    /// −(deflection in the load direction)/L.
-    pub v_over_l: f64,
-}
-
-/// The elastica load path of one beam.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ElasticaPath {
-    pub plane_strain: bool,
-    pub bending_stiffness: f64,
-    pub points: Vec<ElasticaPoint>,
-}
 
 pub(super) fn elastica_path(spec: &CantileverSpec, plane_strain: bool) -> Option<ElasticaPath> {
     let ei = bending_stiffness(spec.young_modulus, spec.poisson_ratio, spec.depth, plane_strain).ok()?;
@@ -59,65 +34,6 @@ pub(super) fn elastica_path(spec: &CantileverSpec, plane_strain: bool) -> Option
             .collect(),
     })
 }
-
-/// Result of one case.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CantileverRecord {
-    pub id: String,
-    pub method: Method,
-    pub domain_update: Option<DomainUpdate>,
-    pub volume_update: Option<VolumeUpdate>,
-    pub depth: f64,
-    pub load: f64,
-    pub element_size: f64,
-    pub load_steps: usize,
-    pub status: CaseStatus,
-    pub failure: Option<FailureRecord>,
-    /// End displacement (mean of the two loaded points) after each converged step.
-    pub end: Vec<EndDisplacement>,
-    /// Final u/L and v/L (converged cases only).
-    pub u_over_l: Option<f64>,
-    pub v_over_l: Option<f64>,
-    /// Plane-strain elastica of this beam at the full load, and the relative differences
-    /// (continuum − elastica)/|elastica|.
-    pub elastica: Option<ElasticaPoint>,
-    pub difference_u: Option<f64>,
-    pub difference_v: Option<f64>,
-    /// Initial domain half-length and the smallest half-length after each converged step.
-    pub initial_half_length: f64,
-    pub min_half_length: Vec<f64>,
-    /// Indices of the two loaded points in the domain snapshots.
-    pub loaded_points: Option<[usize; 2]>,
-    pub newton_iterations: usize,
-    pub steps: Vec<StepRecord>,
-}
-
-/// One row of the depth study.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct DepthRow {
-    pub case: String,
-    pub elements_through_depth: i64,
-    pub depth: f64,
-    pub load: f64,
-    pub element_size: f64,
-    pub u_over_l: Option<f64>,
-    pub v_over_l: Option<f64>,
-    pub difference_u: Option<f64>,
-    pub difference_v: Option<f64>,
-}
-
-/// The cantilever's measures in `results.json`: the elastica and the depth study.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct CantileverMeasures {
-    /// Plane strain first, then plane stress when asked for.
-    pub elastica: Vec<ElasticaPath>,
-    pub depth_study: Vec<DepthRow>,
-}
-
-/// `results.json` of the cantilever study.
-pub type CantileverResults = Results<CantileverStudy>;
-
-case_record!(CantileverRecord);
 
 /// Solve one case, taking domain snapshots every `snapshot_every` steps (0: none).
 fn solve_case_snapshots(
@@ -178,16 +94,7 @@ impl StudyKind for CantileverStudy {
         (self.cases(tier), SweepIndex::new())
     }
     fn key(&self, c: &CantileverCase) -> CaseKey {
-        CaseKey {
-            id: c.id.clone(),
-            hash: case_hash(&CaseDefinition {
-                id: &c.id,
-                method: c.method,
-                spec: &c.spec,
-                snapshot_every: c.snapshot_every,
-            }),
-            has_vtk: c.method.uses_material_points(),
-        }
+        CaseKey::of_spec(&c.id, c.method, &c.spec, c.snapshot_every)
     }
     fn cost(&self, c: &CantileverCase) -> f64 {
         (c.spec.length / c.spec.element_size) * (c.spec.points_per_cell as f64).powi(2)
@@ -229,12 +136,9 @@ impl StudyKind for CantileverStudy {
     }
     /// `domains.json`: the snapshots of the cases a figure draws (`snapshot_every` > 0).
     fn write_side_files(&self, dir: &Path, outputs: &[Self::Output]) -> Result<(), StudyError> {
-        let drawn: BTreeMap<&str, &Vec<DomainSnapshot>> = outputs
-            .iter()
-            .filter(|(r, s)| !s.is_empty() && self.cases.iter().any(|c| c.id == r.id && c.snapshot_every > 0))
-            .map(|(r, s)| (r.id.as_str(), s))
-            .collect();
-        write_json(&dir.join("domains.json"), &drawn, false)
+        write_case_data(&dir.join("domains.json"), outputs, |r, s| {
+            !s.is_empty() && self.cases.iter().any(|c| c.id == r.id && c.snapshot_every > 0)
+        })
     }
 }
 

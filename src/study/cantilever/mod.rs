@@ -15,6 +15,7 @@
 mod checks;
 pub mod kind;
 mod plan;
+pub mod records;
 
 use super::vocabulary::{GhostSection, NewtonSection, WeakNodeSection};
 use crate::method::Method;
@@ -187,6 +188,8 @@ pub struct CantileverCase {
     pub snapshot_every: usize,
 }
 
-pub use kind::{
+/// Material point domains at one step, as `domains.json` stores them.
+pub use crate::problems::cantilever::DomainSnapshot;
+pub use records::{
     CantileverMeasures, CantileverRecord, CantileverResults, DepthRow, ElasticaPath, ElasticaPoint,
 };

@@ -16,8 +16,8 @@ use crate::problems::column::ColumnSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
 
-/// Which problem a column study file solves (the elastic and the plastic column of §5.1; the
-/// plane-strain studies are dispatched by [`registry`]).
+/// The `problem` of a column study file: the elastic and the plastic column of §5.1
+/// ([`crate::kinds`] dispatches every kind on this key).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ProblemKind {
@@ -110,7 +110,7 @@ pub struct QuickOverrides {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Sweep {
-    /// Identifier used by expectations and figures (see [`ident_ok`]).
+    /// Identifier used by expectations and figures (see [`ident_ok`](crate::study::vocabulary::ident_ok)).
     pub id: String,
     /// One line saying what the sweep reproduces.
     pub title: String,
@@ -197,7 +197,7 @@ pub enum FigureKind {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FigureSpec {
-    /// File stem of the SVG (see [`ident_ok`]).
+    /// File stem of the SVG (see [`ident_ok`](crate::study::vocabulary::ident_ok)).
     pub id: String,
     pub title: String,
     pub kind: FigureKind,
@@ -215,9 +215,9 @@ pub struct FigureSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StudySpec {
-    /// Layout version; must equal [`SCHEMA_VERSION`].
+    /// Layout version; must equal [`SCHEMA_VERSION`](crate::study::SCHEMA_VERSION).
     pub schema: i64,
-    /// Name of the study and of its output folder (see [`ident_ok`]).
+    /// Name of the study and of its output folder (see [`ident_ok`](crate::study::vocabulary::ident_ok)).
     pub name: String,
     /// One line for `study list` and `--help`.
     pub summary: String,

@@ -2,7 +2,7 @@
 //! FEM, else the finest FEM mesh, else the finest iGIMP case) and the study file's
 //! expectations (deviation, convergence, weak-node and ghost spreads).
 
-use super::kind::{CompactionRecord, CompactionResults, ReferenceRecord};
+use super::records::{CompactionRecord, CompactionResults, ReferenceRecord};
 use crate::method::Method;
 use crate::study::checks::{check_at_most, relative_spread, richardson, CheckRecord};
 use crate::study::vocabulary::number;

@@ -2,97 +2,16 @@
 //! ([`crate::problems::compaction::solve`]); its record carries Figure 17's measure and the
 //! Newton histories, and the domains of the drawn cases go to `domains.json`.
 
+use super::records::{CompactionMeasures, CompactionRecord};
 use super::{CompactionCase, CompactionFigureKind, CompactionStudy};
 use crate::method::Method;
 use crate::problems::compaction::{solve, DomainRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
-use crate::study::results::{
-    case_record, write_json, CaseStatus, FailureRecord, SolveRecord, StepRecord, SweepIndex,
-};
-use crate::study::store::case_hash;
+use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};
 use crate::study::vtk_output::{write_domain_frames, DomainFrame};
 use crate::study::{StudyError, Tier};
-use serde::{Deserialize, Serialize};
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeSet;
 use std::path::Path;
-
-/// Result of one case.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CompactionRecord {
-    pub id: String,
-    pub method: Method,
-    /// Element size h.
-    pub h: f64,
-    /// Points per element along each axis; `None` (null) for FEM.
-    pub points_per_cell: Option<usize>,
-    pub yield_stress: Option<f64>,
-    pub weak_node_tolerance: f64,
-    /// Ghost penalty factor γ of the case (0: off; FEM: 0).
-    pub ghost_gamma: f64,
-    /// Faces carrying the ghost penalty (`cut` or `all`).
-    pub ghost_faces: crate::ghost::GhostFaces,
-    /// Load steps that needed cutbacks, and the failed attempts in all.
-    pub steps_cut: usize,
-    pub cutbacks: usize,
-    pub status: CaseStatus,
-    pub failure: Option<FailureRecord>,
-    /// Bottom-right point's horizontal displacement plus half its domain's growth (Figure 17);
-    /// converged cases only.
-    pub max_horizontal_displacement: Option<f64>,
-    /// The same measure at the last converged step of a failed case.
-    pub last_converged_displacement: Option<f64>,
-    /// Weak-node constraints applied, summed over the load steps.
-    pub weak_nodes_treated: usize,
-    /// Material points (iGIMP) or elements (FEM).
-    pub points: usize,
-    pub newton_iterations: usize,
-    pub steps: Vec<StepRecord>,
-}
-
-/// The value Figure 17 is normalised by.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ReferenceRecord {
-    pub value: f64,
-    pub method: Method,
-    /// The case(s) it comes from.
-    pub cases: Vec<String>,
-    /// Observed convergence order when Richardson-extrapolated.
-    pub observed_order: Option<f64>,
-    /// One sentence for captions and the report.
-    pub description: String,
-}
-
-/// The compaction's measures in `results.json`: the Figure 17 reference.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct CompactionMeasures {
-    pub reference: Option<ReferenceRecord>,
-}
-
-/// `results.json` of the compaction study.
-pub type CompactionResults = Results<CompactionStudy>;
-
-case_record!(CompactionRecord);
-
-impl CompactionResults {
-    /// The iGIMP case of a sweep at (h, points per cell) with the study's weak-node tolerance.
-    pub fn igimp_case(&self, sweep: &str, h: f64, ppc: usize) -> Option<&CompactionRecord> {
-        self.sweep(sweep).into_iter().find(|c| {
-            c.method == Method::Igimp && c.h == h && c.points_per_cell == Some(ppc) && self.is_default(c)
-        })
-    }
-
-    /// Does the case use the study's default treatment of nearly empty cells (weak-node
-    /// tolerance and ghost γ)? FEM cases always do.
-    pub fn is_default(&self, c: &CompactionRecord) -> bool {
-        match c.points_per_cell {
-            None => true,
-            Some(p) => {
-                c.weak_node_tolerance == self.study.weak_nodes.tolerance
-                    && c.ghost_gamma == self.study.ghost.settings(p, c.yield_stress.is_some(), None).gamma
-            }
-        }
-    }
-}
 
 fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
     let s = &case.spec;
@@ -129,16 +48,6 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
     (rec, o.map_or(vec![], |o| o.domains))
 }
 
-/// The inputs that define a plane-strain case's result, hashed for `--resume`.
-#[derive(Serialize)]
-pub(crate) struct CaseDefinition<'a, S> {
-    pub id: &'a str,
-    pub method: Method,
-    pub spec: &'a S,
-    /// Domain snapshots taken for the figures (0: none).
-    pub snapshot_every: usize,
-}
-
 impl StudyKind for CompactionStudy {
     const PROBLEM: &'static str = "compaction";
     type Case = CompactionCase;
@@ -151,16 +60,7 @@ impl StudyKind for CompactionStudy {
         self.cases(tier)
     }
     fn key(&self, c: &CompactionCase) -> CaseKey {
-        CaseKey {
-            id: c.id.clone(),
-            hash: case_hash(&CaseDefinition {
-                id: &c.id,
-                method: c.method,
-                spec: &c.spec,
-                snapshot_every: 0,
-            }),
-            has_vtk: c.method.uses_material_points(),
-        }
+        CaseKey::of_spec(&c.id, c.method, &c.spec, 0)
     }
     fn cost(&self, c: &CompactionCase) -> f64 {
         let s = &c.spec;
@@ -183,12 +83,7 @@ impl StudyKind for CompactionStudy {
     /// `domains.json`: the final domains of the cases the domain figures draw.
     fn write_side_files(&self, dir: &Path, outputs: &[Self::Output]) -> Result<(), StudyError> {
         let drawn = self.drawn_cases();
-        let domains: BTreeMap<&str, &Vec<DomainRecord>> = outputs
-            .iter()
-            .filter(|(r, _)| drawn.contains(&r.id))
-            .map(|(r, d)| (r.id.as_str(), d))
-            .collect();
-        write_json(&dir.join("domains.json"), &domains, false)
+        write_case_data(&dir.join("domains.json"), outputs, |r, _| drawn.contains(&r.id))
     }
 }
 

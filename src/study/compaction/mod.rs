@@ -12,6 +12,7 @@
 mod checks;
 pub mod kind;
 mod plan;
+pub mod records;
 
 use super::vocabulary::{GhostSection, NewtonSection, WeakNodeSection};
 use crate::method::Method;
@@ -219,4 +220,6 @@ pub struct CompactionCase {
     pub spec: CompactionSpec,
 }
 
-pub use kind::{CompactionMeasures, CompactionRecord, CompactionResults, ReferenceRecord};
+/// A final material point domain, as `domains.json` stores it.
+pub use crate::problems::compaction::DomainRecord;
+pub use records::{CompactionMeasures, CompactionRecord, CompactionResults, ReferenceRecord};

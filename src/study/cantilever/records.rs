@@ -1,0 +1,87 @@
+//! What a cantilever study's `results.json` holds besides the envelope: the case records and
+//! the kind's measures. The kind fills them, the checks and the renderer read them.
+
+use super::CantileverStudy;
+use crate::method::Method;
+use crate::mpm::{DomainUpdate, VolumeUpdate};
+use crate::problems::cantilever::EndDisplacement;
+use crate::study::results::{case_record, CaseStatus, Envelope, FailureRecord, StepRecord};
+use serde::{Deserialize, Serialize};
+
+/// The elastica at one load: the end displacement in the model's axes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ElasticaPoint {
+    pub load: f64,
+    /// α = PL²/EI.
+    pub alpha: f64,
+    pub u_over_l: f64,
+    /// −(deflection in the load direction)/L.
+    pub v_over_l: f64,
+}
+
+/// The elastica load path of one beam.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ElasticaPath {
+    pub plane_strain: bool,
+    pub bending_stiffness: f64,
+    pub points: Vec<ElasticaPoint>,
+}
+
+/// Result of one case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CantileverRecord {
+    pub id: String,
+    pub method: Method,
+    pub domain_update: Option<DomainUpdate>,
+    pub volume_update: Option<VolumeUpdate>,
+    pub depth: f64,
+    pub load: f64,
+    pub element_size: f64,
+    pub load_steps: usize,
+    pub status: CaseStatus,
+    pub failure: Option<FailureRecord>,
+    /// End displacement (mean of the two loaded points) after each converged step.
+    pub end: Vec<EndDisplacement>,
+    /// Final u/L and v/L (converged cases only).
+    pub u_over_l: Option<f64>,
+    pub v_over_l: Option<f64>,
+    /// Plane-strain elastica of this beam at the full load, and the relative differences
+    /// (continuum − elastica)/|elastica|.
+    pub elastica: Option<ElasticaPoint>,
+    pub difference_u: Option<f64>,
+    pub difference_v: Option<f64>,
+    /// Initial domain half-length and the smallest half-length after each converged step.
+    pub initial_half_length: f64,
+    pub min_half_length: Vec<f64>,
+    /// Indices of the two loaded points in the domain snapshots.
+    pub loaded_points: Option<[usize; 2]>,
+    pub newton_iterations: usize,
+    pub steps: Vec<StepRecord>,
+}
+
+/// One row of the depth study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DepthRow {
+    pub case: String,
+    pub elements_through_depth: i64,
+    pub depth: f64,
+    pub load: f64,
+    pub element_size: f64,
+    pub u_over_l: Option<f64>,
+    pub v_over_l: Option<f64>,
+    pub difference_u: Option<f64>,
+    pub difference_v: Option<f64>,
+}
+
+/// The cantilever's measures in `results.json`: the elastica and the depth study.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CantileverMeasures {
+    /// Plane strain first, then plane stress when asked for.
+    pub elastica: Vec<ElasticaPath>,
+    pub depth_study: Vec<DepthRow>,
+}
+
+/// `results.json` of the cantilever study.
+pub type CantileverResults = Envelope<CantileverStudy, CantileverRecord, CantileverMeasures>;
+
+case_record!(CantileverRecord);
