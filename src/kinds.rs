@@ -9,6 +9,7 @@ use crate::study::cantilever::CantileverStudy;
 use crate::study::column::StudySpec;
 use crate::study::compaction::CompactionStudy;
 use crate::study::engine::{self, RunOptions, StudyKind};
+use crate::study::manufactured::ManufacturedStudy;
 use crate::study::results::{problem_of_results, problem_of_study, RunSummary};
 use crate::study::{StudyError, Tier};
 use std::path::{Path, PathBuf};
@@ -18,6 +19,7 @@ pub const KINDS: &[Kind] = &[
     Kind::of::<StudySpec>(render::column::render, render::column::index_entry),
     Kind::of::<CompactionStudy>(render::compaction::render, render::compaction::index_entry),
     Kind::of::<CantileverStudy>(render::cantilever::render, render::cantilever::index_entry),
+    Kind::of::<ManufacturedStudy>(render::manufactured::render, render::manufactured::index_entry),
 ];
 
 /// What `study` asks of one study file.

@@ -236,6 +236,17 @@ pub fn convergence_svg(
     series: &[ConvergenceSeries],
     slope_triangles: bool,
 ) -> PlotResult<String> {
+    convergence_svg_along(title, "number of elements", y_desc, series, slope_triangles)
+}
+
+/// [`convergence_svg`] with the x axis described by `x_desc` (e.g. elements per side).
+pub fn convergence_svg_along(
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[ConvergenceSeries],
+    slope_triangles: bool,
+) -> PlotResult<String> {
     // Triangles under the finest segment: the hypotenuse has the fitted slope, the right angle
     // is at the bottom left, the top vertex at 0.45× the error of the second-finest point.
     let triangles: Vec<Option<[(f64, f64); 3]>> = series
@@ -285,7 +296,7 @@ pub fn convergence_svg(
             .map_err(err)?;
         chart
             .configure_mesh()
-            .x_desc("number of elements")
+            .x_desc(x_desc)
             .y_desc(y_desc)
             .axis_desc_style((FONT, AXIS_DESC_PT))
             .label_style((FONT, TICK_PT))

@@ -129,18 +129,16 @@ pub fn report_markdown(results: &CantileverResults) -> String {
         }
         s.push('\n');
     }
+    s.push_str(&super::gci_markdown(&results.measures.gci));
     s.push_str(&failures_markdown(
         results
             .cases
             .iter()
             .map(|c| (c.id.as_str(), c.status, c.failure.as_ref())),
     ));
-    if !study.figures.is_empty() {
-        s.push_str("## Figures\n\n");
-        for f in &study.figures {
-            let _ = writeln!(s, "### {}\n\n![{}]({}.svg)\n", f.title, f.id, f.id);
-        }
-    }
+    s.push_str(&super::figures_markdown(
+        study.figures.iter().map(|f| (f.title.as_str(), f.id.as_str())),
+    ));
     s
 }
 

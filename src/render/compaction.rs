@@ -210,6 +210,7 @@ pub fn report_markdown(results: &CompactionResults) -> String {
         count(CaseStatus::Rejected)
     );
     s.push_str(&figure17_table(results));
+    s.push_str(&super::gci_markdown(&results.measures.gci));
     s.push_str(&checks_markdown(&results.checks));
     for p in &spec.paper_residuals {
         let _ = writeln!(s, "- {}: [{}]({})", p.table, p.title, p.file);
@@ -222,12 +223,9 @@ pub fn report_markdown(results: &CompactionResults) -> String {
             .iter()
             .map(|c| (c.id.as_str(), c.status, c.failure.as_ref())),
     ));
-    if !spec.figures.is_empty() {
-        s.push_str("## Figures\n\n");
-        for f in &spec.figures {
-            let _ = writeln!(s, "### {}\n\n![{}]({}.svg)\n", f.title, f.id, f.id);
-        }
-    }
+    s.push_str(&super::figures_markdown(
+        spec.figures.iter().map(|f| (f.title.as_str(), f.id.as_str())),
+    ));
     s
 }
 

@@ -6,8 +6,9 @@
 pub mod cantilever;
 pub mod column;
 pub mod compaction;
+pub mod manufactured;
 
-use crate::study::checks::{check_counts, CheckRecord};
+use crate::study::checks::{check_counts, CheckRecord, GciRecord};
 use crate::study::results::{write_text, CaseStatus, FailureRecord};
 use crate::study::{StudyError, Tier};
 use std::fmt::Write as _;
@@ -30,6 +31,19 @@ pub fn index_page(entries: &[IndexEntry]) -> String {
         s.push_str(&e.markdown);
     }
     s
+}
+
+/// The `## Figures` section of a report: each figure's title and image (id.svg).
+pub(crate) fn figures_markdown<'a>(figures: impl IntoIterator<Item = (&'a str, &'a str)>) -> String {
+    let mut s = String::new();
+    for (title, id) in figures {
+        let _ = writeln!(s, "### {title}\n\n![{id}]({id}.svg)\n");
+    }
+    if s.is_empty() {
+        s
+    } else {
+        format!("## Figures\n\n{s}")
+    }
 }
 
 /// The index header line of a study: its name, summary, tier and check counts.
@@ -155,4 +169,49 @@ pub fn failures_markdown<'a>(
     format!(
         "## Cases that did not converge\n\n| case | status | step | reason | last residuals |\n|---|---|---:|---|---|\n{rows}\n"
     )
+}
+
+/// The grid convergence indices (Celik et al. 2008) over the three finest levels of each
+/// series: h, the finest value, p, the extrapolated value, e_a, e_ext, GCI_fine and the
+/// asymptotic-range ratio; a series without one says why.
+pub fn gci_markdown(records: &[GciRecord]) -> String {
+    if records.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(
+        "## Grid convergence index (Celik et al. 2008, three finest levels)\n\n| sweep | series | measure | h fine, medium, coarse | φ1 | p | φ_ext | e_a (%) | e_ext (%) | GCI_fine (%) | GCI32 / (r^p GCI21) | range |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|\n",
+    );
+    for r in records {
+        match &r.gci {
+            Some(g) => {
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {} | {}, {}, {} | {:.6} | {:.2} | {:.6} | {:.3} | {:.3} | {:.3} | {:.3} | {} |",
+                    r.sweep,
+                    r.series,
+                    r.measure,
+                    g.h[0],
+                    g.h[1],
+                    g.h[2],
+                    g.values[0],
+                    g.order,
+                    g.extrapolated,
+                    100.0 * g.approximate_error,
+                    100.0 * g.extrapolated_error,
+                    100.0 * g.gci_fine,
+                    g.asymptotic_ratio,
+                    r.note
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {} | — | — | — | — | — | — | — | — | {} |",
+                    r.sweep, r.series, r.measure, r.note
+                );
+            }
+        }
+    }
+    s.push('\n');
+    s
 }

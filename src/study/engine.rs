@@ -133,6 +133,22 @@ macro_rules! study_file_fields {
 }
 pub(crate) use study_file_fields;
 
+/// Every distinct case of `sweeps` (id, cases) in file order, a case shared by two sweeps
+/// once, and the case ids of each sweep: what [`StudyKind::cases`] returns.
+pub fn distinct_cases<C>(
+    sweeps: impl IntoIterator<Item = (String, Vec<C>)>,
+    id: impl Fn(&C) -> &str,
+) -> (Vec<C>, SweepIndex) {
+    let mut seen = std::collections::BTreeSet::new();
+    let mut all = vec![];
+    let mut index = SweepIndex::new();
+    for (sweep, cases) in sweeps {
+        index.insert(sweep, cases.iter().map(|c| id(c).to_string()).collect());
+        all.extend(cases.into_iter().filter(|c| seen.insert(id(c).to_string())));
+    }
+    (all, index)
+}
+
 /// `results.json` of study kind `K`.
 pub type Results<K> = Envelope<K, <K as StudyKind>::Record, <K as StudyKind>::Measures>;
 

@@ -16,6 +16,7 @@ pub mod checks;
 pub mod column;
 pub mod compaction;
 pub mod engine;
+pub mod manufactured;
 pub mod results;
 pub mod store;
 pub mod vocabulary;

@@ -3,5 +3,6 @@
 
 mod cantilever_study;
 mod compaction_study;
+mod manufactured_study;
 mod study;
 mod usability;

@@ -12,6 +12,7 @@ mod elastica;
 mod fem;
 mod fem2d;
 mod hostile;
+mod manufactured;
 mod patch;
 mod plasticity;
 mod robustness;

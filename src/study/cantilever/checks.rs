@@ -3,7 +3,7 @@
 
 use super::records::{CantileverRecord, CantileverResults, DepthRow};
 use super::CantileverStudy;
-use crate::study::checks::{check_at_most, CheckRecord};
+use crate::study::checks::{check_at_most, CheckRecord, GciRecord};
 use crate::study::results::CaseStatus;
 
 fn largest_difference(du: Option<f64>, dv: Option<f64>) -> Option<f64> {
@@ -159,4 +159,38 @@ pub(super) fn depth_rows(study: &CantileverStudy, records: &[CantileverRecord]) 
             .then(b.depth.total_cmp(&a.depth))
     });
     rows
+}
+
+/// The GCI of the final u/L and v/L at each depth of the depth study, over its element sizes
+/// (h = depth / elements through the depth).
+pub(super) fn gci_records(study: &CantileverStudy, rows: &[DepthRow]) -> Vec<GciRecord> {
+    let Some(d) = &study.depth_study else {
+        return vec![];
+    };
+    let mut depths: Vec<f64> = rows.iter().map(|r| r.depth).collect();
+    depths.sort_by(|a, b| b.total_cmp(a));
+    depths.dedup();
+    let mut out = vec![];
+    for depth in depths {
+        for (measure, value) in [
+            (
+                "final u/L",
+                (|r: &DepthRow| r.u_over_l) as fn(&DepthRow) -> Option<f64>,
+            ),
+            ("final v/L", |r: &DepthRow| r.v_over_l),
+        ] {
+            let levels: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.depth == depth)
+                .filter_map(|r| Some((r.element_size, value(r)?)))
+                .collect();
+            out.push(GciRecord::of(
+                "depth-study",
+                format!("`{}` at depth {depth}", d.case),
+                measure,
+                levels,
+            ));
+        }
+    }
+    out
 }

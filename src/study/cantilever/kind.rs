@@ -128,9 +128,11 @@ impl StudyKind for CantileverStudy {
         if study.plane_stress_elastica {
             elastica.extend(elastica_path(&base, false));
         }
+        let depth_study = super::checks::depth_rows(study, &results.cases);
         results.measures = CantileverMeasures {
             elastica,
-            depth_study: super::checks::depth_rows(study, &results.cases),
+            gci: super::checks::gci_records(study, &depth_study),
+            depth_study,
         };
         results.checks = super::checks::compute_checks(results);
     }

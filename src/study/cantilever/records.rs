@@ -79,6 +79,9 @@ pub struct CantileverMeasures {
     /// Plane strain first, then plane stress when asked for.
     pub elastica: Vec<ElasticaPath>,
     pub depth_study: Vec<DepthRow>,
+    /// Grid convergence index of the end displacement at each depth of the depth study.
+    #[serde(default)]
+    pub gci: Vec<crate::study::checks::GciRecord>,
 }
 
 /// `results.json` of the cantilever study.

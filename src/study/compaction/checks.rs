@@ -4,7 +4,7 @@
 
 use super::records::{CompactionRecord, CompactionResults, ReferenceRecord};
 use crate::method::Method;
-use crate::study::checks::{check_at_most, relative_spread, richardson, CheckRecord};
+use crate::study::checks::{check_at_most, relative_spread, richardson, CheckRecord, GciRecord};
 use crate::study::vocabulary::number;
 use std::collections::BTreeSet;
 
@@ -208,6 +208,43 @@ pub(super) fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
             e.tolerance,
             &e.source,
         ));
+    }
+    out
+}
+
+/// The GCI of Figure 17's measure for every series (method, points per cell, the study's
+/// default treatment) of every sweep with three or more element sizes.
+pub(super) fn gci_records(results: &CompactionResults) -> Vec<GciRecord> {
+    let mut out = vec![];
+    for sw in &results.study.sweeps {
+        let cases = results.sweep(&sw.id);
+        let hs: BTreeSet<u64> = cases.iter().map(|c| c.h.to_bits()).collect();
+        if hs.len() < 3 {
+            continue;
+        }
+        let mut series: Vec<(Method, Option<usize>)> = vec![];
+        for c in cases.iter().filter(|c| results.is_default(c)) {
+            if !series.contains(&(c.method, c.points_per_cell)) {
+                series.push((c.method, c.points_per_cell));
+            }
+        }
+        for (m, ppc) in series {
+            let levels: Vec<(f64, f64)> = cases
+                .iter()
+                .filter(|c| c.method == m && c.points_per_cell == ppc && results.is_default(c))
+                .filter_map(|c| Some((c.h, c.max_horizontal_displacement?)))
+                .collect();
+            let label = match ppc {
+                Some(p) => format!("{}, {p}×{p} points", m.label()),
+                None => m.label().to_string(),
+            };
+            out.push(GciRecord::of(
+                &sw.id,
+                label,
+                "max horizontal displacement",
+                levels,
+            ));
+        }
     }
     out
 }

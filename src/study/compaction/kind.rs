@@ -78,6 +78,7 @@ impl StudyKind for CompactionStudy {
     }
     fn measure(results: &mut Results<Self>) {
         results.measures.reference = super::checks::figure17_reference(results);
+        results.measures.gci = super::checks::gci_records(results);
         results.checks = super::checks::compute_checks(results);
     }
     /// `domains.json`: the final domains of the cases the domain figures draw.

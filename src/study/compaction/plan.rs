@@ -5,6 +5,7 @@
 use super::{CompactionCase, CompactionFigureKind, CompactionStudy, CompactionSweep};
 use crate::method::Method;
 use crate::problems::compaction::{CompactionSpec, METHODS};
+use crate::study::engine::distinct_cases;
 use crate::study::results::SweepIndex;
 use crate::study::vocabulary::{max_points_per_axis, number, Checker, Header, MAX_POINTS_PER_CELL};
 use crate::study::{StudyError, Tier};
@@ -241,16 +242,11 @@ impl CompactionStudy {
 
     /// Every distinct case of the tier in file order, and the case ids of each sweep.
     pub fn cases(&self, tier: Tier) -> (Vec<CompactionCase>, SweepIndex) {
-        let mut seen = BTreeSet::new();
-        let mut all = vec![];
-        let mut index = SweepIndex::new();
-        for s in &self.sweeps {
-            let Some(plan) = self.plan(s, tier) else { continue };
-            let cases = self.sweep_cases(s, &plan);
-            index.insert(s.id.clone(), cases.iter().map(|c| c.id.clone()).collect());
-            all.extend(cases.into_iter().filter(|c| seen.insert(c.id.clone())));
-        }
-        (all, index)
+        let sweeps = self
+            .sweeps
+            .iter()
+            .filter_map(|s| Some((s.id.clone(), self.sweep_cases(s, &self.plan(s, tier)?))));
+        distinct_cases(sweeps, |c| &c.id)
     }
 }
 

@@ -56,6 +56,9 @@ pub struct ReferenceRecord {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct CompactionMeasures {
     pub reference: Option<ReferenceRecord>,
+    /// Grid convergence index of each series with three or more element sizes.
+    #[serde(default)]
+    pub gci: Vec<crate::study::checks::GciRecord>,
 }
 
 /// `results.json` of the compaction study.
