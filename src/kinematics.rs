@@ -106,6 +106,16 @@ pub fn dlog(lam: &Vector3<f64>, q: &Matrix3<f64>) -> Tensor4 {
     l
 }
 
+/// Whether the tangent carries its geometric term (always, unless a seeded bug removes it).
+#[inline(always)]
+fn geometric_term() -> bool {
+    #[cfg(feature = "seeded-bugs")]
+    if crate::seeded::active(crate::seeded::Bug::NoGeometricTerm) {
+        return false;
+    }
+    true
+}
+
 /// Spatial consistent tangent a_ijkl = (1/2J) D^alg_ijmn L_mnpq B_pqkl − σ_il δ_jk, eqs (25)–(26),
 /// with B_pqkl = δ_pk b_ql + δ_qk b_pl evaluated at the trial b^e.
 ///
@@ -143,7 +153,12 @@ pub fn spatial_tangent<const D: usize>(
                     for r in 0..9 {
                         s += d_alg[(row, r)] * lb[(r, col)];
                     }
-                    a[(row, col)] = scale * s - if jj == k { sigma[(i, ll)] } else { 0.0 };
+                    a[(row, col)] = scale * s
+                        - if jj == k && geometric_term() {
+                            sigma[(i, ll)]
+                        } else {
+                            0.0
+                        };
                 }
             }
         }
@@ -181,7 +196,12 @@ pub fn spatial_tangent_eigen<const D: usize>(
                             s += d_alg[(row, ij(m, n))] * de[(m, n)];
                         }
                     }
-                    a[(row, col)] = s / j - if jj == k { sigma[(i, l)] } else { 0.0 };
+                    a[(row, col)] = s / j
+                        - if jj == k && geometric_term() {
+                            sigma[(i, l)]
+                        } else {
+                            0.0
+                        };
                 }
             }
         }
@@ -307,12 +327,25 @@ pub fn evaluate_point<const D: usize>(
         .map_err(|e| PointError::Material(e.0))?;
     let sigma = response.tau / j; // eq (16)
     let block = SMatrix::<f64, D, D>::from_fn(|r, c| delta_f[(r, c)]);
-    let delta_f_inv = block.try_inverse().ok_or(PointError::Inverted(det_df))?;
+    #[allow(unused_mut)]
+    let mut delta_f_inv = block.try_inverse().ok_or(PointError::Inverted(det_df))?;
+    #[allow(unused_mut)]
+    let mut volume = det_df * state.volume; // eq (28)
+    #[cfg(feature = "seeded-bugs")]
+    {
+        use crate::seeded::{active, Bug};
+        if active(Bug::NoDeltaFInverse) {
+            delta_f_inv = SMatrix::identity();
+        }
+        if active(Bug::NoVolumeChange) {
+            volume = state.volume;
+        }
+    }
     Ok(PointTrial {
         delta_f,
         f,
         sigma,
-        volume: det_df * state.volume,
+        volume,
         delta_f_inv,
         response,
         b_trial_eigenvalues: lam,

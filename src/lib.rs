@@ -58,6 +58,8 @@ pub mod plot2d;
 pub mod problems;
 pub mod quadrature;
 pub mod render;
+#[cfg(feature = "seeded-bugs")]
+pub mod seeded;
 pub mod study;
 pub mod tensor;
 pub mod vtk;

@@ -1,0 +1,34 @@
+//! Deliberately wrong kernels, compiled only with the `seeded-bugs` feature, so that the test
+//! `tests/seeded.rs` can show each key check failing on a broken variant. The default build has
+//! none of this: every call site is behind `#[cfg(feature = "seeded-bugs")]`.
+//!
+//! One process-wide switch (the solvers assemble on rayon threads, so a thread-local would not
+//! reach them); the test that sets it runs its variants one after another in one test function.
+
+use std::sync::atomic::{AtomicU8, Ordering};
+
+/// A seeded bug.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Bug {
+    /// The correct kernels.
+    None = 0,
+    /// The spatial tangent without its geometric term −σ_il δ_jk (eq 25).
+    NoGeometricTerm = 1,
+    /// Eq (36) without ΔF⁻¹: start-of-step gradients used as current ones.
+    NoDeltaFInverse = 2,
+    /// V_p = V_p^n instead of det(ΔF) V_p^n (eq 28).
+    NoVolumeChange = 3,
+}
+
+static ACTIVE: AtomicU8 = AtomicU8::new(0);
+
+/// Switch the kernels to `bug` (or back, with [`Bug::None`]).
+pub fn set(bug: Bug) {
+    ACTIVE.store(bug as u8, Ordering::SeqCst);
+}
+
+/// Is `bug` the one switched on?
+pub fn active(bug: Bug) -> bool {
+    ACTIVE.load(Ordering::Relaxed) == bug as u8
+}

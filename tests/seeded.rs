@@ -1,0 +1,133 @@
+//! Checks that prove they can fail: each key check runs on a deliberately wrong variant and
+//! must catch it, while passing on the correct kernels. The wrong kernels exist only with the
+//! `seeded-bugs` feature (`src/seeded.rs`): `cargo test --release --features seeded-bugs
+//! --test seeded` (run by `.ci/run`). One test function, so the process-wide switch is never
+//! shared between concurrent tests.
+//!
+//! | bug | check that must catch it |
+//! |---|---|
+//! | tangent without −σ_il δ_jk (eq 25) | Newton order on the vortex (check_quadratic, order ≥ 1.8) |
+//! | eq 36 without ΔF⁻¹ | the manufactured study's rate bands |
+//! | V_p without det ΔF (eq 28) | the manufactured study's rate bands |
+//! | stress error at x_p instead of X_p | the iGIMP stress-rate band (1.64 ± 0.25) |
+
+use igimp::method::Method;
+use igimp::newton::check_quadratic;
+use igimp::problems::manufactured::{errors, solve, Exact, Field, ManufacturedSpec, PointValue};
+use igimp::seeded::{set, Bug};
+use igimp::study::engine::{run_in_memory, StudyKind};
+use igimp::study::manufactured::ManufacturedStudy;
+use igimp::study::Tier;
+use std::path::Path;
+
+fn study() -> ManufacturedStudy {
+    ManufacturedStudy::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/manufactured.toml")).unwrap()
+}
+
+/// (passed, failed, not evaluated) of the manufactured quick tier's rate checks, and the ids
+/// of those that did not pass.
+fn rate_checks() -> ((usize, usize, usize), Vec<String>) {
+    let run = run_in_memory(&study(), "manufactured.toml", Tier::Quick).unwrap();
+    let bad = run
+        .results
+        .checks
+        .iter()
+        .filter(|c| c.pass != Some(true))
+        .map(|c| c.id.clone())
+        .collect();
+    (run.results.check_counts(), bad)
+}
+
+/// The lowest convergence order check_quadratic measures over the vortex's load steps (iGIMP,
+/// h = 1/8, 2×2 points), or the error it reports.
+fn newton_order() -> Result<f64, String> {
+    let spec = ManufacturedSpec {
+        field: Field::Vortex,
+        amplitude: 0.6,
+        cells: 8,
+        ..ManufacturedSpec::default()
+    };
+    let o = solve(&spec, Method::Igimp).map_err(|e| e.to_string())?;
+    if let Some(f) = o.failure {
+        return Err(f.to_string());
+    }
+    let mut worst = f64::INFINITY;
+    for s in &o.steps {
+        let q = check_quadratic(&s.newton.residuals, 1e-3, 1e-12, 1.0, 1.8)
+            .map_err(|e| format!("step {}: {e}", s.step))?;
+        worst = worst.min(q.min_order);
+    }
+    Ok(worst)
+}
+
+/// Fitted slope of the stress error over h = 1/8, 1/16, 1/32 (axis-aligned, iGIMP, 2×2
+/// points), the error evaluated by `sigma_at` (X_p, or x_p for the seeded mistake).
+fn stress_rate(at_current: bool) -> f64 {
+    let mut h = vec![];
+    let mut e = vec![];
+    for n in [8, 16, 32] {
+        let spec = ManufacturedSpec {
+            cells: n,
+            ..ManufacturedSpec::default()
+        };
+        let o = solve(&spec, Method::Igimp).unwrap();
+        let exact = Exact::of(&spec);
+        let pts: Vec<PointValue> = o
+            .points
+            .iter()
+            .map(|p| PointValue {
+                x0: if at_current { p.x } else { p.x0 },
+                ..*p
+            })
+            .collect();
+        // `errors` evaluates σ(X) at x0; with at_current it sees σ(x_p). The displacement part
+        // is not used.
+        h.push(1.0 / n as f64);
+        e.push(errors(&exact, &pts).stress);
+    }
+    igimp::norms::fitted_rate(&h, &e).unwrap()
+}
+
+#[test]
+fn every_seeded_bug_is_caught() {
+    // The correct kernels pass everything the variants must fail.
+    set(Bug::None);
+    let ((pass, fail, none), bad) = rate_checks();
+    assert_eq!((fail, none), (0, 0), "correct kernels: {bad:?}");
+    assert_eq!(pass, 14);
+    let order = newton_order().expect("correct kernels converge quadratically");
+    assert!(order >= 1.8, "correct kernels: order {order}");
+    let rate = stress_rate(false);
+    assert!((rate - 1.64).abs() <= 0.25, "correct stress rate {rate}");
+    eprintln!("control: 14/14 rate checks pass, Newton order >= {order:.2}, stress rate {rate:.2}");
+
+    // 1. No geometric term: the solution is unchanged, so the rate bands cannot see it, but
+    //    Newton is no longer quadratic.
+    set(Bug::NoGeometricTerm);
+    let caught = newton_order();
+    eprintln!("no geometric term: Newton order check -> {caught:?}");
+    assert!(
+        caught.is_err(),
+        "a tangent without its geometric term passed the Newton-order check"
+    );
+
+    // 2, 3. Wrong kinematics: the manufactured solution's rate bands fail.
+    for bug in [Bug::NoDeltaFInverse, Bug::NoVolumeChange] {
+        set(bug);
+        let ((pass, fail, none), bad) = rate_checks();
+        eprintln!("{bug:?}: rate checks {pass} passed, {fail} failed, {none} not evaluated: {bad:?}");
+        assert!(
+            bad.iter().any(|id| id.contains("igimp")),
+            "{bug:?} passed every iGIMP rate band"
+        );
+    }
+    set(Bug::None);
+
+    // 4. The stress error at the current position: the band of the iGIMP stress rate fails.
+    let wrong = stress_rate(true);
+    eprintln!("stress error at x_p: fitted rate {wrong:.2} against the band 1.64 ± 0.25");
+    assert!(
+        (wrong - 1.64).abs() > 0.25,
+        "the stress error at x_p passed the band: {wrong}"
+    );
+}
