@@ -407,7 +407,7 @@ pub fn solve(spec: &ManufacturedSpec, method: Method) -> Result<ManufacturedSolu
     let exact = Exact::of(spec);
     let (steps, failure, points) = match method {
         Method::Igimp | Method::Mpm => solve_mpm(spec, &exact, method)?,
-        Method::FemQ4 | Method::FemQ8 => solve_fem(spec, &exact, method)?,
+        Method::FemQ4 | Method::FemQ8 => solve_fem(spec, method)?,
         _ => return Err(method.unsupported("manufactured problem", &METHODS)),
     };
     let errors = failure.is_none().then(|| errors(&exact, &points));
@@ -472,7 +472,14 @@ fn solve_mpm(spec: &ManufacturedSpec, exact: &Exact, method: Method) -> Result<R
     Ok((steps, failure, values))
 }
 
-fn solve_fem(spec: &ManufacturedSpec, exact: &Exact, method: Method) -> Result<Run, InputError> {
+/// The Q4 (`fem-q4`) or Q8 (`fem-q8`) solver of `spec`: the unit square meshed by its cells,
+/// rollers on every edge, the dead load as consistent nodal forces, undeformed.
+pub fn fem_solver(spec: &ManufacturedSpec, method: Method) -> Result<PlaneFem, InputError> {
+    spec.validate()?;
+    let exact = &Exact::of(spec);
+    if !matches!(method, Method::FemQ4 | Method::FemQ8) {
+        return Err(method.unsupported("manufactured FEM solver", &[Method::FemQ4, Method::FemQ8]));
+    }
     let element = if method == Method::FemQ4 {
         QuadElement::Q4
     } else {
@@ -512,7 +519,11 @@ fn solve_fem(spec: &ManufacturedSpec, exact: &Exact, method: Method) -> Result<R
         linear_solver: LinearSolver::Lu,
     };
     let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
-    let mut fem = PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings)?;
+    PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings)
+}
+
+fn solve_fem(spec: &ManufacturedSpec, method: Method) -> Result<Run, InputError> {
+    let mut fem = fem_solver(spec, method)?;
     let (steps, failure) = match fem.run() {
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
