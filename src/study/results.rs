@@ -323,6 +323,19 @@ pub fn read_results<T: DeserializeOwned>(dir: &Path) -> Result<T, StudyError> {
     read_json(&dir.join("results.json"))
 }
 
+/// `<dir>/points/`, created, without the point files (`*.csv`) of an earlier run.
+pub fn fresh_points_dir(dir: &Path) -> Result<PathBuf, StudyError> {
+    let pdir = dir.join("points");
+    std::fs::create_dir_all(&pdir).map_err(|e| StudyError::io(&pdir, e))?;
+    for entry in std::fs::read_dir(&pdir).map_err(|e| StudyError::io(&pdir, e))? {
+        let p = entry.map_err(|e| StudyError::io(&pdir, e))?.path();
+        if p.extension().is_some_and(|x| x == "csv") {
+            std::fs::remove_file(&p).map_err(|e| StudyError::io(&p, e))?;
+        }
+    }
+    Ok(pdir)
+}
+
 /// Write `text` to `path` atomically and note it in `written`.
 pub fn write_text(path: &Path, text: &str, written: &mut Vec<PathBuf>) -> Result<(), StudyError> {
     super::store::write_file(path, text.as_bytes())?;

@@ -14,7 +14,7 @@ use crate::method::Method;
 use crate::problems::column::{solve_column_observed, ColumnObserver, ColumnSpec, PointRecord};
 use crate::study::checks::{check_rate, CheckRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
-use crate::study::results::{CaseStatus, SolveRecord, SweepIndex};
+use crate::study::results::{fresh_points_dir, CaseStatus, SolveRecord, SweepIndex};
 use crate::study::store::{case_hash, confined, write_file};
 use crate::study::vtk_output::ColumnVtkWriter;
 use crate::study::{StudyError, Tier};
@@ -142,14 +142,7 @@ impl StudyKind for StudySpec {
     }
     /// `points/<case>.csv` of every case that was solved (stale point files removed).
     fn write_side_files(&self, dir: &Path, outputs: &[ColumnOutput]) -> Result<(), StudyError> {
-        let pdir = dir.join("points");
-        std::fs::create_dir_all(&pdir).map_err(|e| StudyError::io(&pdir, e))?;
-        for entry in std::fs::read_dir(&pdir).map_err(|e| StudyError::io(&pdir, e))? {
-            let p = entry.map_err(|e| StudyError::io(&pdir, e))?.path();
-            if p.extension().is_some_and(|x| x == "csv") {
-                std::fs::remove_file(&p).map_err(|e| StudyError::io(&p, e))?;
-            }
-        }
+        let pdir = fresh_points_dir(dir)?;
         let plastic = self.column.yield_stress.is_some();
         for o in outputs.iter().filter(|o| o.record.status != CaseStatus::Rejected) {
             let p = confined(&pdir, &format!("{}.csv", o.record.id))?;

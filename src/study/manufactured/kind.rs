@@ -8,7 +8,7 @@ use super::{FigureKind, ManufacturedCase, ManufacturedStudy};
 use crate::method::Method;
 use crate::problems::manufactured::{solve, Exact, PointValue};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
-use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};
+use crate::study::results::{fresh_points_dir, write_case_data, CaseStatus, SolveRecord, SweepIndex};
 use crate::study::store::{confined, write_file};
 use crate::study::vtk_output::{write_domain_frames, DomainFrame};
 use crate::study::{StudyError, Tier};
@@ -127,14 +127,7 @@ impl StudyKind for ManufacturedStudy {
     /// `points/<case>.csv` of every converged case (stale point files removed) and
     /// `domains.json`, the points of the cases a domain figure draws.
     fn write_side_files(&self, dir: &Path, outputs: &[Self::Output]) -> Result<(), StudyError> {
-        let pdir = dir.join("points");
-        std::fs::create_dir_all(&pdir).map_err(|e| StudyError::io(&pdir, e))?;
-        for entry in std::fs::read_dir(&pdir).map_err(|e| StudyError::io(&pdir, e))? {
-            let p = entry.map_err(|e| StudyError::io(&pdir, e))?.path();
-            if p.extension().is_some_and(|x| x == "csv") {
-                std::fs::remove_file(&p).map_err(|e| StudyError::io(&p, e))?;
-            }
-        }
+        let pdir = fresh_points_dir(dir)?;
         for (r, p) in outputs.iter().filter(|(r, _)| r.status == CaseStatus::Converged) {
             let path = confined(&pdir, &format!("{}.csv", r.id))?;
             write_file(&path, points_csv(&p.points).as_bytes())?;
