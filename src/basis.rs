@@ -163,6 +163,22 @@ impl Basis {
                 let l_global = h * (t_hi - t_lo);
                 let l_local = 2.0 * (t_hi - t_lo);
                 let t_c = 0.5 * (t_lo + t_hi);
+                #[cfg(feature = "seeded-bugs")]
+                if crate::seeded::active(crate::seeded::Bug::NoElementSplit) {
+                    // The seeded mistake: eqs (7)-(10) with ξ1, ξ2 not clipped to the element
+                    // (eqs 8-9) on the centre's element only.
+                    let e = (t_c.floor().max(0.0) as usize).min(cells - 1);
+                    let xi_p = 2.0 * (t_c - e as f64) - 1.0;
+                    let (xi1, xi2) = (xi_p - 0.5 * l_local, xi_p + 0.5 * l_local);
+                    *out = AxisWeights::default();
+                    out.first = e;
+                    out.len = 2;
+                    out.w[0] = (2.0 * xi2 - xi2 * xi2 - 2.0 * xi1 + xi1 * xi1) / (4.0 * l_local);
+                    out.w[1] = (2.0 * xi2 + xi2 * xi2 - 2.0 * xi1 - xi1 * xi1) / (4.0 * l_local);
+                    out.dw[0] = (xi1 - xi2) / (2.0 * l_global);
+                    out.dw[1] = (xi2 - xi1) / (2.0 * l_global);
+                    return Ok(());
+                }
                 for e in e_lo..=e_hi {
                     let xi_p = 2.0 * (t_c - e as f64) - 1.0;
                     let (sa, sb, dsa, dsb) = gimp_element_weights(xi_p, l_local, l_global);

@@ -19,6 +19,9 @@ pub enum Bug {
     NoDeltaFInverse = 2,
     /// V_p = V_p^n instead of det(ΔF) V_p^n (eq 28).
     NoVolumeChange = 3,
+    /// GIMP weights without the per-element split of eqs (7)–(10) (Figure 3): the whole
+    /// domain integrated against the shape functions of the element holding its centre.
+    NoElementSplit = 4,
 }
 
 static ACTIVE: AtomicU8 = AtomicU8::new(0);

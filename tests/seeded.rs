@@ -10,6 +10,7 @@
 //! | eq 36 without ΔF⁻¹ | the manufactured study's rate bands |
 //! | V_p without det ΔF (eq 28) | the manufactured study's rate bands |
 //! | stress error at x_p instead of X_p | the iGIMP stress-rate band (1.64 ± 0.25) |
+//! | GIMP weights without the per-element split (eqs 7–10) | weights against direct quadrature of ∫χ_p N_v, and the rate bands |
 
 use igimp::method::Method;
 use igimp::newton::check_quadratic;
@@ -88,6 +89,39 @@ fn stress_rate(at_current: bool) -> f64 {
     igimp::norms::fitted_rate(&h, &e).unwrap()
 }
 
+/// Largest difference between the GIMP weights of domains straddling an element edge and
+/// (1/2r) ∫ N_v over the domain by direct quadrature of the true hat functions (20,000
+/// midpoints): the per-element split is what makes them agree.
+fn gimp_weight_error() -> f64 {
+    use igimp::basis::{AxisWeights, Basis, GridAxis};
+    let axis = GridAxis {
+        axis: 0,
+        origin: 0.0,
+        spacing: 1.0,
+        cells: 8,
+    };
+    let hat = |v: usize, y: f64| (1.0 - (y - v as f64).abs()).max(0.0);
+    let mut worst: f64 = 0.0;
+    for (x, r) in [(3.9, 0.25), (4.1, 0.3), (2.95, 0.45), (5.5, 0.5), (3.7, 0.6)] {
+        let mut w = AxisWeights::default();
+        Basis::Gimp.axis_weights(axis, x, r, &mut w).unwrap();
+        for v in 0..=8usize {
+            let n = 20_000;
+            let q: f64 = (0..n)
+                .map(|i| hat(v, x - r + 2.0 * r * (i as f64 + 0.5) / n as f64))
+                .sum::<f64>()
+                / n as f64;
+            let got = if (w.first..w.first + w.len).contains(&v) {
+                w.w[v - w.first]
+            } else {
+                0.0
+            };
+            worst = worst.max((got - q).abs());
+        }
+    }
+    worst
+}
+
 #[test]
 fn every_seeded_bug_is_caught() {
     // The correct kernels pass everything the variants must fail.
@@ -99,7 +133,9 @@ fn every_seeded_bug_is_caught() {
     assert!(order >= 1.8, "correct kernels: order {order}");
     let rate = stress_rate(false);
     assert!((rate - 1.64).abs() <= 0.25, "correct stress rate {rate}");
-    eprintln!("control: 14/14 rate checks pass, Newton order >= {order:.2}, stress rate {rate:.2}");
+    let w = gimp_weight_error();
+    assert!(w < 1e-8, "correct GIMP weights off the quadrature by {w:e}");
+    eprintln!("control: 14/14 rate checks pass, Newton quadratic, stress rate {rate:.2}, GIMP weights within {w:.1e} of the quadrature");
 
     // 1. No geometric term: the solution is unchanged, so the rate bands cannot see it, but
     //    Newton is no longer quadratic.
@@ -111,8 +147,15 @@ fn every_seeded_bug_is_caught() {
         "a tangent without its geometric term passed the Newton-order check"
     );
 
-    // 2, 3. Wrong kinematics: the manufactured solution's rate bands fail.
-    for bug in [Bug::NoDeltaFInverse, Bug::NoVolumeChange] {
+    // 2, 3, 5. Wrong kinematics or weights: the manufactured solution's rate bands fail.
+    set(Bug::NoElementSplit);
+    let w = gimp_weight_error();
+    eprintln!("no element split: GIMP weights off the quadrature by {w:.3e}");
+    assert!(
+        w > 1e-3,
+        "GIMP weights without the per-element split passed: {w:e}"
+    );
+    for bug in [Bug::NoDeltaFInverse, Bug::NoVolumeChange, Bug::NoElementSplit] {
         set(bug);
         let ((pass, fail, none), bad) = rate_checks();
         eprintln!("{bug:?}: rate checks {pass} passed, {fail} failed, {none} not evaluated: {bad:?}");
