@@ -388,9 +388,36 @@ impl<const D: usize> MpmSolver<D> {
     }
 }
 
-impl<const D: usize> LoadStepping for MpmSolver<D> {
-    fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
-        self.build_supports().map_err(|f| (f, vec![]))?;
+/// The [`StepInput`] of a prepared step; a macro so that it borrows the solver's fields, not
+/// the whole solver (the workspace is borrowed mutably beside it).
+macro_rules! step_input {
+    ($solver:ident, $step:ident) => {
+        StepInput {
+            model: $solver.model.as_ref(),
+            states: &$solver.points.state,
+            num_nodes: $solver.grid.num_nodes(),
+            fixed: &$step.fixed,
+            ties: &$step.ties,
+            point_forces: &$step.forces,
+            nodal_forces: &[],
+            ghost: $solver.settings.ghost.is_on().then_some(&$solver.ghost),
+        }
+    };
+}
+
+/// What one load step of the material point solver assembles from: the point forces at its
+/// load factor and the constraints of its weak nodes.
+struct PreparedStep<const D: usize> {
+    forces: Vec<SVector<f64, D>>,
+    fixed: Vec<(usize, usize)>,
+    ties: Vec<(usize, usize)>,
+    weak_nodes: usize,
+}
+
+impl<const D: usize> MpmSolver<D> {
+    /// Weights, ghost term, forces and constraints of a step at `load_factor`.
+    fn prepare_step(&mut self, load_factor: f64) -> Result<PreparedStep<D>, StepFailure> {
+        self.build_supports()?;
         self.build_ghost();
         let forces = self.external_point_forces(load_factor);
         let (weak, ties) = self.weak_nodes();
@@ -401,23 +428,38 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
                 .filter(|n| !tied.contains(n))
                 .flat_map(|&n| (0..D).map(move |a| (n, a))),
         );
-        let ghost = self.settings.ghost.is_on().then_some(&self.ghost);
-        let input = StepInput {
-            model: self.model.as_ref(),
-            states: &self.points.state,
-            num_nodes: self.grid.num_nodes(),
-            fixed: &fixed,
-            ties: &ties,
-            point_forces: &forces,
-            nodal_forces: &[],
-            ghost,
-        };
+        Ok(PreparedStep {
+            forces,
+            fixed,
+            ties,
+            weak_nodes: weak.len(),
+        })
+    }
+
+    /// The nonlinear system of the next load step at `load_factor` (unknowns: the nodal
+    /// displacement increment from the committed state), for evaluations outside Newton, e.g.
+    /// the residual of a prescribed field. Nothing is committed.
+    pub fn with_step_system<R>(
+        &mut self,
+        load_factor: f64,
+        f: impl FnOnce(&mut crate::assembly::LoadStepSystem<'_, D>) -> R,
+    ) -> Result<R, StepFailure> {
+        let step = self.prepare_step(load_factor)?;
+        let input = step_input!(self, step);
+        Ok(self.work.with_system(&input, f))
+    }
+}
+
+impl<const D: usize> LoadStepping for MpmSolver<D> {
+    fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
+        let step = self.prepare_step(load_factor).map_err(|f| (f, vec![]))?;
+        let input = step_input!(self, step);
         self.work.matrix.set_solver(self.settings.linear_solver);
         let report = self.work.solve(&input, &self.settings.newton)?;
         self.commit().map_err(|f| (f, report.residuals.clone()))?;
         Ok(Increment {
             newton: report,
-            weak_nodes: weak.len(),
+            weak_nodes: step.weak_nodes,
         })
     }
     fn steps_done(&self) -> usize {

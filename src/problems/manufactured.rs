@@ -406,7 +406,7 @@ pub fn solve(spec: &ManufacturedSpec, method: Method) -> Result<ManufacturedSolu
     spec.validate()?;
     let exact = Exact::of(spec);
     let (steps, failure, points) = match method {
-        Method::Igimp | Method::Mpm => solve_mpm(spec, &exact, method)?,
+        Method::Igimp | Method::Mpm => solve_mpm(spec, method)?,
         Method::FemQ4 | Method::FemQ8 => solve_fem(spec, method)?,
         _ => return Err(method.unsupported("manufactured problem", &METHODS)),
     };
@@ -421,7 +421,17 @@ pub fn solve(spec: &ManufacturedSpec, method: Method) -> Result<ManufacturedSolu
 
 type Run = (Vec<StepReport>, Option<SolveError>, Vec<PointValue>);
 
-fn solve_mpm(spec: &ManufacturedSpec, exact: &Exact, method: Method) -> Result<Run, InputError> {
+/// The iGIMP (`igimp`) or MPM (`mpm`) solver of `spec`: points filling the unit square
+/// grid, rollers on every edge, the dead load on the points, undeformed.
+pub fn mpm_solver(spec: &ManufacturedSpec, method: Method) -> Result<MpmSolver<2>, InputError> {
+    spec.validate()?;
+    let exact = &Exact::of(spec);
+    if !method.uses_material_points() {
+        return Err(method.unsupported(
+            "manufactured material point solver",
+            &[Method::Igimp, Method::Mpm],
+        ));
+    }
     let h = spec.element_size();
     let grid = Grid::try_new([0.0, 0.0], [h, h], [spec.cells, spec.cells])?;
     let ppc = spec.points_per_cell;
@@ -454,7 +464,11 @@ fn solve_mpm(spec: &ManufacturedSpec, exact: &Exact, method: Method) -> Result<R
         gravity: SVector::zeros(),
         point_loads,
     };
-    let mut solver = MpmSolver::try_new(grid, points, model, fixed, loads, settings)?;
+    MpmSolver::try_new(grid, points, model, fixed, loads, settings)
+}
+
+fn solve_mpm(spec: &ManufacturedSpec, method: Method) -> Result<Run, InputError> {
+    let mut solver = mpm_solver(spec, method)?;
     let (steps, failure) = match solver.run() {
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),

@@ -129,17 +129,21 @@ fn vortex_is_still_outside_its_core() {
 }
 
 /// The exact field's own residual: the manufactured displacement interpolated at the FEM
-/// nodes, fed to the internal force at the full load, leaves ‖f_int − f_ext‖ / ‖f_ext‖ that
+/// nodes (iGIMP, MPM: the grid nodes), fed to the internal force at the full load from the
+/// undeformed state, leaves ‖f_int − f_ext‖ / ‖f_ext‖ that
 /// converges with h at a fitted order (h = 1/8, 1/16, 1/32), which checks b₀ and its
 /// quadrature together (a wrong b₀ would leave an O(1) residual). Measured 2026-12-01, at
 /// h = 1/8, 1/16, 1/32: axis-aligned Q4 6.65e-3, 1.76e-3, 4.45e-4 (slope 1.95), Q8 3.56e-3,
 /// 9.22e-4, 2.33e-4 (1.97); vortex Q4 1.08e-1, 3.64e-2, 1.20e-2 (1.58), Q8 1.03e-1, 3.39e-2,
-/// 1.08e-2 (1.63, pre-asymptotic like its displacement). Bands: the measured slopes ± 0.3.
+/// 1.08e-2 (1.63, pre-asymptotic like its displacement); iGIMP and MPM (2×2 points) 9.77e-3,
+/// 2.52e-3, 6.34e-4 (1.97) and 1.17e-1, 3.68e-2, 1.23e-2 (1.63), the same for both because the
+/// undeformed domains lie inside their cells, where GIMP weights equal MPM's. Bands: the
+/// measured slopes ± 0.3.
 #[test]
 fn exact_field_residual_converges() {
     use igimp::method::Method;
     use igimp::newton::{NonlinearSystem, ResidualNorm};
-    use igimp::problems::manufactured::fem_solver;
+    use igimp::problems::manufactured::{fem_solver, mpm_solver};
     let residual = |field: Field, method: Method, n: usize| -> f64 {
         let spec = ManufacturedSpec {
             field,
@@ -148,24 +152,31 @@ fn exact_field_residual_converges() {
             ..ManufacturedSpec::default()
         };
         let e = Exact::of(&spec);
-        let mut fem = fem_solver(&spec, method).unwrap();
-        let nodal: Vec<f64> = fem
-            .mesh0
-            .nodes
-            .iter()
-            .flat_map(|x| {
-                let y = e.position([x[0], x[1]]);
-                [y[0] - x[0], y[1] - x[1]]
-            })
-            .collect();
-        fem.with_step_system(1.0, |sys| {
+        let at = |x: [f64; 2]| {
+            let y = e.position(x);
+            [y[0] - x[0], y[1] - x[1]]
+        };
+        let norm = |sys: &mut igimp::assembly::LoadStepSystem<'_, 2>, nodal: &[f64]| {
             let mut u = vec![0.0; sys.num_unknowns()];
-            sys.dofs.gather(&nodal, &mut u);
+            sys.dofs.gather(nodal, &mut u);
             let mut r = vec![0.0; u.len()];
             sys.evaluate(&u, &mut r).unwrap();
             r.iter().map(|x| x * x).sum::<f64>().sqrt() / sys.reference_norm(ResidualNorm::External)
-        })
-        .unwrap()
+        };
+        if method.uses_material_points() {
+            let mut s = mpm_solver(&spec, method).unwrap();
+            let nodal: Vec<f64> = (0..s.grid.num_nodes())
+                .flat_map(|k| {
+                    let x = s.grid.node_position(k);
+                    at([x[0], x[1]])
+                })
+                .collect();
+            s.with_step_system(1.0, |sys| norm(sys, &nodal)).unwrap()
+        } else {
+            let mut fem = fem_solver(&spec, method).unwrap();
+            let nodal: Vec<f64> = fem.mesh0.nodes.iter().flat_map(|x| at([x[0], x[1]])).collect();
+            fem.with_step_system(1.0, |sys| norm(sys, &nodal)).unwrap()
+        }
     };
     let mut report = vec![];
     for (field, method, expected) in [
@@ -173,6 +184,10 @@ fn exact_field_residual_converges() {
         (Field::AxisAligned, Method::FemQ8, 1.97),
         (Field::Vortex, Method::FemQ4, 1.58),
         (Field::Vortex, Method::FemQ8, 1.63),
+        (Field::AxisAligned, Method::Igimp, 1.97),
+        (Field::Vortex, Method::Igimp, 1.63),
+        (Field::AxisAligned, Method::Mpm, 1.97),
+        (Field::Vortex, Method::Mpm, 1.63),
     ] {
         let r: Vec<f64> = [8, 16, 32].iter().map(|&n| residual(field, method, n)).collect();
         let h = [1.0 / 8.0, 1.0 / 16.0, 1.0 / 32.0];
