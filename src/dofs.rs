@@ -6,8 +6,9 @@
 
 use nalgebra::{SMatrix, SVector};
 
-/// Most nodes one integration point may touch (4 per axis in 3D).
-pub const MAX_POINT_NODES: usize = 64;
+/// Most nodes one integration point may touch: [`crate::basis::MAX_AXIS_NODES`] per axis in 3D.
+pub const MAX_POINT_NODES: usize =
+    crate::basis::MAX_AXIS_NODES * crate::basis::MAX_AXIS_NODES * crate::basis::MAX_AXIS_NODES;
 
 /// For every point: the nodes it touches, the weights S and gradients ∂S/∂X̃ on the
 /// start-of-step configuration. Stored flat (CSR-like) and refilled every load step.

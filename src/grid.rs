@@ -20,8 +20,8 @@ pub struct Grid<const D: usize> {
 impl<const D: usize> Grid<D> {
     /// A grid starting at `origin` with `cells[a]` elements of size `spacing[a]` along axis `a`.
     pub fn try_new(origin: [f64; D], spacing: [f64; D], cells: [usize; D]) -> Result<Self, InputError> {
-        if D == 0 || D > 2 {
-            return Err(InputError::new("grid.dimension", D, "1 or 2 (3D is planned)"));
+        if D == 0 || D > 3 {
+            return Err(InputError::new("grid.dimension", D, "1, 2 or 3"));
         }
         for a in 0..D {
             require_finite(&format!("grid.origin[{a}]"), origin[a])?;

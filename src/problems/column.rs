@@ -286,10 +286,23 @@ pub struct ColumnSpec {
     /// but one point per cell needs it on every face).
     #[serde(default, skip_serializing_if = "is_off")]
     pub ghost: GhostSettings,
+    /// 1: the column of the paper; 3: the same column as a 1 × 1 × n prism of unit cross
+    /// section with rollers on its lateral faces (uniaxial strain, as in 1D), on a 3D grid of
+    /// one cell across (MPM/GIMP only so far).
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub dimension: usize,
 }
 
 fn is_off(g: &GhostSettings) -> bool {
     !g.is_on()
+}
+
+fn one() -> usize {
+    1
+}
+
+fn is_one(d: &usize) -> bool {
+    *d == 1
 }
 
 impl Default for ColumnSpec {
@@ -307,6 +320,7 @@ impl Default for ColumnSpec {
             yield_stress: None,
             gauss_points: None,
             ghost: GhostSettings::default(),
+            dimension: 1,
         }
     }
 }
@@ -314,6 +328,9 @@ impl Default for ColumnSpec {
 impl ColumnSpec {
     /// Check every field; the error names the field and its allowed range.
     pub fn validate(&self) -> Result<(), InputError> {
+        if !matches!(self.dimension, 1 | 3) {
+            return Err(InputError::new("dimension", self.dimension, "must be 1 or 3"));
+        }
         require_positive("length", self.length)?;
         LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?;
         require_positive("density", self.density)?;
@@ -392,6 +409,73 @@ impl ColumnSpec {
         };
         MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, settings)
     }
+}
+
+impl ColumnSpec {
+    /// The 3D prism of this column (`dimension = 3`): a grid of 1 × 1 × `elements` cells of
+    /// 1 × 1 × h (unit cross section), points 2 × 2 × `points_per_cell` per cell, every lateral
+    /// node on rollers (u_x = u_y = 0, so the strain is uniaxial as in 1D), the base fixed,
+    /// gravity along −z. Two points across, not one: with one, the mode u_z ∝ (x − ½)(y − ½)
+    /// of each level's four nodes has no stiffness (the point sits where its value and
+    /// gradient vanish) and the tangent is singular.
+    pub fn mpm_solver_3d(&self, basis: Basis) -> Result<MpmSolver<3>, InputError> {
+        self.validate()?;
+        let h = self.length / self.elements as f64;
+        let grid = Grid::try_new([0.0; 3], [1.0, 1.0, h], [1, 1, self.elements])?;
+        let points = MaterialPoints::fill_box(
+            &grid,
+            [0.0; 3],
+            [1.0, 1.0, self.length],
+            [2, 2, self.points_per_cell],
+            self.density,
+        )?;
+        let mut fixed: Vec<(usize, usize)> = (0..grid.num_nodes()).flat_map(|n| [(n, 0), (n, 1)]).collect();
+        fixed.extend(grid.nodes_on_plane(2, 0.0).into_iter().map(|n| (n, 2)));
+        let loads = Loads {
+            gravity: SVector::<f64, 3>::new(0.0, 0.0, -self.gravity()),
+            point_loads: vec![],
+        };
+        let settings = MpmSettings {
+            basis,
+            domain_update: DomainUpdate::Stretch,
+            newton: self.newton,
+            load_steps: self.load_steps,
+            weak_node_tolerance: 0.0,
+            weak_node_treatment: Default::default(),
+            volume_update: Default::default(),
+            linear_solver: Default::default(),
+            ghost: self.ghost,
+        };
+        MpmSolver::try_new(grid, points, self.model()?, fixed, loads, settings)
+    }
+}
+
+fn solve_mpm_3d(spec: &ColumnSpec, basis: Basis) -> Result<ColumnOutcome, InputError> {
+    let mut solver = spec.mpm_solver_3d(basis)?;
+    let (steps, failure) = match solver.run() {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    let pts = &solver.points;
+    let records: Vec<PointRecord> = (0..pts.len())
+        .map(|p| {
+            let st = &pts.state[p];
+            let sigma = st.cauchy();
+            PointRecord {
+                z0: pts.position0[p][2],
+                z: pts.position[p][2],
+                volume0: pts.volume0[p],
+                sigma_zz: sigma[(2, 2)],
+                sigma_xx: sigma[(0, 0)],
+                f_zz: st.f[(2, 2)],
+                plastic_multiplier: st.material.plastic_multiplier,
+            }
+        })
+        .collect();
+    let top = (0..pts.len())
+        .max_by(|&a, &b| pts.position0[a][2].total_cmp(&pts.position0[b][2]))
+        .map_or(f64::NAN, |p| pts.displacement(p)[2]);
+    Ok(ColumnOutcome::from_records(spec, records, top, steps, failure))
 }
 
 /// Final values at one integration point.
@@ -515,6 +599,26 @@ pub fn solve_column(spec: &ColumnSpec, method: Method) -> Result<ColumnOutcome, 
 /// [`solve_column`], showing the solver to `observer` before the first and after every
 /// converged load step.
 pub fn solve_column_observed(
+    spec: &ColumnSpec,
+    method: Method,
+    observer: &mut ColumnObserver<'_>,
+) -> Result<ColumnOutcome, InputError> {
+    match (method, spec.dimension) {
+        (Method::Mpm, 3) => solve_mpm_3d(spec, Basis::Mpm),
+        (Method::Igimp, 3) => solve_mpm_3d(spec, Basis::Gimp),
+        (_, 3) => Err(InputError::new(
+            "dimension",
+            3,
+            format!(
+                "the 3D column is solved by mpm and igimp only ({} in 3D needs the Hex8/Hex20 comparators)",
+                method.name()
+            ),
+        )),
+        _ => match_1d(spec, method, observer),
+    }
+}
+
+fn match_1d(
     spec: &ColumnSpec,
     method: Method,
     observer: &mut ColumnObserver<'_>,

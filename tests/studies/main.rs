@@ -2,6 +2,7 @@
 //! for byte, resume, ParaView output and thread-count independence. One test binary.
 
 mod cantilever_study;
+mod column3d_study;
 mod compaction_study;
 mod manufactured_study;
 mod study;

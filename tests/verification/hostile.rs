@@ -476,10 +476,11 @@ proptest! {
         newton in newton(),
         yield_stress in prop::option::of(float_or_hostile(1.0, 1e6)),
         gauss_points in prop::option::of(count_or_hostile(0, 6)),
+        dimension in prop::sample::select(vec![1usize, 2, 3]),
     ) {
         let spec = ColumnSpec {
             length, young_modulus, poisson_ratio, density, weight, elements, points_per_cell,
-            load_steps, newton, yield_stress, gauss_points, ghost: Default::default(),
+            load_steps, newton, yield_stress, gauss_points, ghost: Default::default(), dimension,
         };
         let ok = no_panic("ColumnSpec::validate", || spec.validate())?.is_some();
         let small = elements * points_per_cell <= 64 && load_steps <= 3 && newton.max_iterations <= 40;

@@ -240,6 +240,18 @@ pub struct StudySpec {
     /// Ghost stabilisation of one point per cell ([`crate::ghost`]); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ghost: Option<ColumnGhost>,
+    /// 1 (default) or 3: the column as a 1 × 1 × n prism with lateral rollers
+    /// ([`ColumnSpec::dimension`]; MPM and iGIMP only).
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub dimension: i64,
+}
+
+fn one() -> i64 {
+    1
+}
+
+fn is_one(d: &i64) -> bool {
+    *d == 1
 }
 
 /// A column study's `[ghost]`: the settings of its one-point-per-cell cases (the odd-even
@@ -322,6 +334,7 @@ impl StudySpec {
                 (1, Some(g)) => g.one_point_per_cell,
                 _ => crate::ghost::GhostSettings::default(),
             },
+            dimension: self.dimension.max(1) as usize,
             ..ColumnSpec::default()
         }
     }

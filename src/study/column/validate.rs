@@ -31,6 +31,9 @@ impl StudySpec {
                 .validate()
                 .map_err(|e| c.err("ghost.one_point_per_cell", e.value.clone(), e.allowed.clone()))?;
         }
+        if !matches!(self.dimension, 1 | 3) {
+            return Err(c.err("dimension", self.dimension, "must be 1 or 3"));
+        }
         let col = &self.column;
         c.positive("column.length", col.length)?;
         c.positive("column.young_modulus", col.young_modulus)?;
@@ -177,8 +180,20 @@ impl StudySpec {
         let k = |f: &str| format!("{prefix}{f}");
         c.non_empty(&k("methods"), methods)?;
         for (j, m) in methods.iter().enumerate() {
-            m.expect_one_of("column", &crate::problems::column::METHODS)
-                .map_err(|e| c.err(format!("{}[{j}]", k("methods")), m.name(), e.allowed))?;
+            let allowed: &[Method] = if self.dimension == 3 {
+                &[Method::Mpm, Method::Igimp]
+            } else {
+                &crate::problems::column::METHODS
+            };
+            m.expect_one_of(
+                if self.dimension == 3 {
+                    "3D column"
+                } else {
+                    "column"
+                },
+                allowed,
+            )
+            .map_err(|e| c.err(format!("{}[{j}]", k("methods")), m.name(), e.allowed))?;
             if methods[..j].contains(m) {
                 return Err(c.err(
                     format!("{}[{j}]", k("methods")),

@@ -1,0 +1,70 @@
+//! The 3D column (`studies/column-3d.toml`: the §5.1 column as a 1 × 1 × n prism with lateral
+//! rollers) reproduces the 1D column: for every case the two studies share (same method,
+//! weight, elements, points per cell along the column), eq (46), the base F error, the top
+//! displacement and the base F agree within 1e-6 relative (measured 2026-12-01: at most
+//! 4e-13), and its Table 1 checks pass.
+
+use igimp::study::column::StudySpec;
+use igimp::study::engine::{run_in_memory, StudyKind};
+use igimp::study::results::CaseStatus;
+use igimp::study::Tier;
+use std::path::Path;
+
+fn quick(file: &str) -> igimp::study::column::records::ColumnResults {
+    let s = StudySpec::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies").join(file)).unwrap();
+    run_in_memory(&s, file, Tier::Quick).unwrap().results
+}
+
+#[test]
+fn column_3d_equals_the_1d_column() {
+    let (d3, d1) = (quick("column-3d.toml"), quick("column.toml"));
+    assert_eq!(d3.study.dimension, 3);
+    let mut compared = 0;
+    let mut worst: f64 = 0.0;
+    for c in &d3.cases {
+        assert_eq!(c.status, CaseStatus::Converged, "{}", c.id);
+        let Some(o) = d1.case(&c.id) else { continue };
+        for (a, b) in [
+            (c.stress_error, o.stress_error),
+            (c.f_error, o.f_error),
+            (c.top_displacement, o.top_displacement),
+            (c.base_f, o.base_f),
+        ] {
+            let (a, b) = (a.unwrap(), b.unwrap());
+            worst = worst.max((a / b - 1.0).abs());
+        }
+        compared += 1;
+    }
+    assert!(compared >= 6, "only {compared} shared cases");
+    assert!(
+        worst <= 1e-6,
+        "3D against 1D: largest relative difference {worst:e}"
+    );
+    for c in &d3.checks {
+        assert_eq!(c.pass, Some(true), "{}: {}", c.id, c.description);
+    }
+}
+
+/// A dimension other than 1 or 3, and FEM in 3D, are input errors naming the field.
+#[test]
+fn column_dimension_is_validated() {
+    use igimp::method::Method;
+    use igimp::problems::column::{solve_column, ColumnSpec};
+    let e = ColumnSpec {
+        dimension: 2,
+        ..ColumnSpec::default()
+    }
+    .validate()
+    .unwrap_err();
+    assert_eq!(e.field, "dimension");
+    let e = solve_column(
+        &ColumnSpec {
+            dimension: 3,
+            ..ColumnSpec::default()
+        },
+        Method::FemLinear,
+    )
+    .unwrap_err();
+    assert_eq!(e.field, "dimension");
+    assert!(e.allowed.contains("mpm and igimp"), "{e}");
+}
