@@ -43,6 +43,13 @@ fn column_3d_equals_the_1d_column() {
     for c in &d3.checks {
         assert_eq!(c.pass, Some(true), "{}: {}", c.id, c.description);
     }
+    // Newton converges quadratically in 3D, as in 1D.
+    for c in &d3.cases {
+        for s in &c.steps {
+            igimp::newton::check_quadratic(&s.residuals, 1e-3, 1e-11, 1.0, 1.8)
+                .unwrap_or_else(|e| panic!("{} step {}: {e}", c.id, s.step));
+        }
+    }
 }
 
 /// A dimension other than 1 or 3, and FEM in 3D, are input errors naming the field.

@@ -262,3 +262,11 @@ fn gimp_domain_is_clipped_at_the_grid_boundary() {
         }
     }
 }
+
+/// The same invariants in 3D (tensor product of the per-element 1D split), anisotropic spacing.
+#[test]
+fn mpm_and_gimp_3d_partition_of_unity_and_linear_reproduction() {
+    let grid = Grid::try_new([0.0, -1.0, 0.5], [0.5, 0.25, 0.4], [6, 8, 5]).unwrap();
+    check_invariants(&grid, Basis::Mpm, 5);
+    check_invariants(&grid, Basis::Gimp, 6);
+}

@@ -126,3 +126,13 @@ fn gimp_and_mpm_2d_patch_homogeneous_deformation() {
         patch(basis, grid, [1.0, 1.0], [4.0, 3.0], fbar);
     }
 }
+
+/// 3D: a general F with stretch, shear and a rotation about an oblique axis.
+#[test]
+fn gimp_and_mpm_3d_patch_homogeneous_deformation() {
+    for basis in [Basis::Gimp, Basis::Mpm] {
+        let grid = Grid::try_new([0.0; 3], [0.5, 0.5, 0.4], [8, 8, 10]).unwrap();
+        let fbar = nalgebra::Matrix3::new(1.1, 0.2, -0.05, -0.15, 0.9, 0.1, 0.05, -0.1, 1.05);
+        patch(basis, grid, [1.0, 1.0, 1.0], [3.0, 3.0, 3.0], fbar);
+    }
+}
