@@ -49,12 +49,13 @@ struct Cli {
     #[arg(long)]
     resume: bool,
     /// Write ParaView files `<out>/<name>/vtk/<case>.pvd` of the initial and the final state:
-    /// column, the material/Gauss points and the grid/mesh; compaction and cantilever, the
-    /// material point domains (quadrilaterals) of the iGIMP cases (FEM cases write none).
+    /// column, the material/Gauss points and the grid/mesh (1D only: column-3d writes none
+    /// yet); compaction, cantilever and manufactured, the material point domains
+    /// (quadrilaterals) of the iGIMP and MPM cases (FEM cases write none).
     #[arg(long)]
     vtk: bool,
     /// With --vtk, also write every N-th load step (implies --vtk; column and cantilever;
-    /// the compaction writes its initial and final states only).
+    /// the compaction writes its initial and final states only, manufactured its final one).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     vtk_every: Option<u32>,
     /// Solve only shard K of N (0 <= K < N): the cases whose index in the deterministic case
