@@ -384,6 +384,21 @@ impl ColumnSpec {
         crate::constitutive::elastic_or_von_mises(self.young_modulus, self.poisson_ratio, self.yield_stress)
     }
 
+    /// Solver settings of the material point column (1D or 3D).
+    fn mpm_settings(&self, basis: Basis) -> MpmSettings {
+        MpmSettings {
+            basis,
+            domain_update: DomainUpdate::Stretch,
+            newton: self.newton,
+            load_steps: self.load_steps,
+            weak_node_tolerance: 0.0,
+            weak_node_treatment: Default::default(),
+            volume_update: Default::default(),
+            linear_solver: Default::default(),
+            ghost: self.ghost,
+        }
+    }
+
     /// The MPM/GIMP solver for this column: grid [0, L0], base node fixed, gravity along −z.
     pub fn mpm_solver(&self, basis: Basis) -> Result<MpmSolver<1>, InputError> {
         self.validate()?;
@@ -396,17 +411,7 @@ impl ColumnSpec {
             gravity: SVector::<f64, 1>::new(-self.gravity()),
             point_loads: vec![],
         };
-        let settings = MpmSettings {
-            basis,
-            domain_update: DomainUpdate::Stretch,
-            newton: self.newton,
-            load_steps: self.load_steps,
-            weak_node_tolerance: 0.0,
-            weak_node_treatment: Default::default(),
-            volume_update: Default::default(),
-            linear_solver: Default::default(),
-            ghost: self.ghost,
-        };
+        let settings = self.mpm_settings(basis);
         MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, settings)
     }
 }
@@ -435,17 +440,7 @@ impl ColumnSpec {
             gravity: SVector::<f64, 3>::new(0.0, 0.0, -self.gravity()),
             point_loads: vec![],
         };
-        let settings = MpmSettings {
-            basis,
-            domain_update: DomainUpdate::Stretch,
-            newton: self.newton,
-            load_steps: self.load_steps,
-            weak_node_tolerance: 0.0,
-            weak_node_treatment: Default::default(),
-            volume_update: Default::default(),
-            linear_solver: Default::default(),
-            ghost: self.ghost,
-        };
+        let settings = self.mpm_settings(basis);
         MpmSolver::try_new(grid, points, self.model()?, fixed, loads, settings)
     }
 }
@@ -456,26 +451,7 @@ fn solve_mpm_3d(spec: &ColumnSpec, basis: Basis) -> Result<ColumnOutcome, InputE
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
     };
-    let pts = &solver.points;
-    let records: Vec<PointRecord> = (0..pts.len())
-        .map(|p| {
-            let st = &pts.state[p];
-            let sigma = st.cauchy();
-            PointRecord {
-                z0: pts.position0[p][2],
-                z: pts.position[p][2],
-                volume0: pts.volume0[p],
-                sigma_zz: sigma[(2, 2)],
-                sigma_xx: sigma[(0, 0)],
-                f_zz: st.f[(2, 2)],
-                plastic_multiplier: st.material.plastic_multiplier,
-            }
-        })
-        .collect();
-    let top = (0..pts.len())
-        .max_by(|&a, &b| pts.position0[a][2].total_cmp(&pts.position0[b][2]))
-        .map_or(f64::NAN, |p| pts.displacement(p)[2]);
-    Ok(ColumnOutcome::from_records(spec, records, top, steps, failure))
+    Ok(mpm_outcome(spec, &solver.points, 2, 0, steps, failure))
 }
 
 /// Final values at one integration point.
@@ -648,26 +624,39 @@ fn solve_mpm_observed(
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
     };
-    let pts = &solver.points;
+    Ok(mpm_outcome(spec, &solver.points, 0, 1, steps, failure))
+}
+
+/// The outcome of a material point column whose axis is `axis` (1D: 0; the 3D prism: 2):
+/// one [`PointRecord`] per point (σ_xx from the lateral axis `lateral`) and the top point's
+/// displacement.
+fn mpm_outcome<const D: usize>(
+    spec: &ColumnSpec,
+    pts: &MaterialPoints<D>,
+    axis: usize,
+    lateral: usize,
+    steps: Vec<StepReport>,
+    failure: Option<SolveError>,
+) -> ColumnOutcome {
     let records: Vec<PointRecord> = (0..pts.len())
         .map(|p| {
             let st = &pts.state[p];
             let sigma = st.cauchy();
             PointRecord {
-                z0: pts.position0[p][0],
-                z: pts.position[p][0],
+                z0: pts.position0[p][axis],
+                z: pts.position[p][axis],
                 volume0: pts.volume0[p],
-                sigma_zz: sigma[(0, 0)],
-                sigma_xx: sigma[(1, 1)],
-                f_zz: st.f[(0, 0)],
+                sigma_zz: sigma[(axis, axis)],
+                sigma_xx: sigma[(lateral, lateral)],
+                f_zz: st.f[(axis, axis)],
                 plastic_multiplier: st.material.plastic_multiplier,
             }
         })
         .collect();
     let top = (0..pts.len())
-        .max_by(|&a, &b| pts.position0[a][0].total_cmp(&pts.position0[b][0]))
-        .map_or(f64::NAN, |p| pts.displacement(p)[0]);
-    Ok(ColumnOutcome::from_records(spec, records, top, steps, failure))
+        .max_by(|&a, &b| pts.position0[a][axis].total_cmp(&pts.position0[b][axis]))
+        .map_or(f64::NAN, |p| pts.displacement(p)[axis]);
+    ColumnOutcome::from_records(spec, records, top, steps, failure)
 }
 
 impl ColumnSpec {

@@ -141,6 +141,21 @@ impl CompactionSpec {
         self.weight / (2.0 * self.half_width * self.height)
     }
 
+    /// Solver settings of the material point block (2D or 3D).
+    fn mpm_settings(&self) -> MpmSettings {
+        MpmSettings {
+            basis: self.basis,
+            domain_update: self.domain_update,
+            newton: self.newton,
+            load_steps: self.load_steps,
+            weak_node_tolerance: self.weak_node_tolerance,
+            weak_node_treatment: self.weak_node_treatment,
+            volume_update: Default::default(),
+            linear_solver: self.linear_solver,
+            ghost: self.ghost,
+        }
+    }
+
     /// The iGIMP/MPM solver of this problem.
     pub fn mpm_solver(&self) -> Result<MpmSolver<2>, InputError> {
         self.validate()?;
@@ -160,18 +175,7 @@ impl CompactionSpec {
             gravity: SVector::<f64, 2>::new(0.0, -self.unit_weight()),
             point_loads: vec![],
         };
-        let settings = MpmSettings {
-            basis: self.basis,
-            domain_update: self.domain_update,
-            newton: self.newton,
-            load_steps: self.load_steps,
-            weak_node_tolerance: self.weak_node_tolerance,
-            weak_node_treatment: self.weak_node_treatment,
-            volume_update: Default::default(),
-            linear_solver: self.linear_solver,
-            ghost: self.ghost,
-        };
-        MpmSolver::try_new(grid, points, self.model()?, fixed, loads, settings)
+        MpmSolver::try_new(grid, points, self.model()?, fixed, loads, self.mpm_settings())
     }
 }
 
@@ -380,18 +384,7 @@ impl CompactionSpec {
             gravity: SVector::<f64, 3>::new(0.0, 0.0, -self.unit_weight()),
             point_loads: vec![],
         };
-        let settings = MpmSettings {
-            basis: self.basis,
-            domain_update: self.domain_update,
-            newton: self.newton,
-            load_steps: self.load_steps,
-            weak_node_tolerance: self.weak_node_tolerance,
-            weak_node_treatment: self.weak_node_treatment,
-            volume_update: Default::default(),
-            linear_solver: self.linear_solver,
-            ghost: self.ghost,
-        };
-        MpmSolver::try_new(grid, points, self.model()?, fixed, loads, settings)
+        MpmSolver::try_new(grid, points, self.model()?, fixed, loads, self.mpm_settings())
     }
 }
 

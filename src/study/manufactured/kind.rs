@@ -6,7 +6,7 @@
 use super::records::{CasePoints, ManufacturedMeasures, ManufacturedRecord};
 use super::{FigureKind, ManufacturedCase, ManufacturedStudy};
 use crate::method::Method;
-use crate::problems::manufactured::{solve, Exact, PointValue};
+use crate::problems::manufactured::{solve, stress_deviations, Exact, PointValue};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{fresh_points_dir, write_case_data, CaseStatus, SolveRecord, SweepIndex};
 use crate::study::store::{confined, write_file};
@@ -39,22 +39,8 @@ fn solve_case(case: &ManufacturedCase) -> (ManufacturedRecord, CasePoints) {
         steps: solved.steps,
     };
     let points = o.map_or(vec![], |o| o.points);
-    let exact = Exact::of(&case.spec);
-    let sigma = |p: &PointValue| exact.cauchy(p.x0);
-    let smax = points.iter().map(|p| sigma(p).norm()).fold(0.0, f64::max);
-    let stress_error = points
-        .iter()
-        .map(|p| {
-            let s = sigma(p);
-            let d = [
-                p.sigma[0] - s[(0, 0)],
-                p.sigma[1] - s[(1, 1)],
-                p.sigma[2] - s[(0, 1)],
-                p.sigma[3] - s[(2, 2)],
-            ];
-            (d[0] * d[0] + d[1] * d[1] + 2.0 * d[2] * d[2] + d[3] * d[3]).sqrt() / smax
-        })
-        .collect();
+    let (deviation, smax) = stress_deviations(&Exact::of(&case.spec), &points);
+    let stress_error = deviation.into_iter().map(|d| d / smax).collect();
     (rec, CasePoints { points, stress_error })
 }
 
