@@ -87,3 +87,24 @@ impl GaussRule {
             .sum()
     }
 }
+
+/// The tensor-product Gauss rule on [−1, 1]^D with `n` points per axis: points and weights
+/// Π_d w_{i_d}, the first axis fastest (the element loops of [`crate::fem`] rely on it).
+pub fn tensor_rule<const D: usize>(n: usize) -> Result<Vec<(nalgebra::SVector<f64, D>, f64)>, InputError> {
+    let rule = GaussRule::try_new(n)?;
+    let total = n.pow(D as u32);
+    let mut out = Vec::with_capacity(total);
+    for flat in 0..total {
+        let mut xi = nalgebra::SVector::<f64, D>::zeros();
+        let mut w = 1.0;
+        let mut rest = flat;
+        for d in 0..D {
+            let i = rest % n;
+            rest /= n;
+            xi[d] = rule.points()[i];
+            w *= rule.weights()[i];
+        }
+        out.push((xi, w));
+    }
+    Ok(out)
+}

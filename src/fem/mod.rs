@@ -46,13 +46,17 @@
 //! stress at the 2 Gauss points is exact (round-off) for any number of elements. With 3
 //! Gauss points the error is O(h²). The paper states both facts (§5.1); the tests pin them.
 
+mod continuum;
+mod hex;
 mod line;
-mod plane;
+mod mesh;
 mod quad;
 mod updated_lagrangian;
 
+pub use continuum::{ContinuumFem, FemLoads, PlaneFem, PlaneFemSettings, PlaneLoads, SolidFem, SolidLoads};
+pub use hex::{HexElement, HexMesh};
 pub use line::{LineElement, LineMesh, MAX_LINE_NODES};
-pub use plane::{PlaneFem, PlaneFemSettings, PlaneLoads};
+pub use mesh::{serendipity_shape, ElementFamily, ElementMesh, Shape, MAX_ELEMENT_NODES};
 pub use quad::{PlaneMesh, QuadElement, MAX_QUAD_NODES};
 pub use updated_lagrangian::{validate_stepping, FemMesh, GaussPoints, MAX_LOAD_STEPS};
 

@@ -32,7 +32,7 @@ pub fn validate_stepping(newton: &NewtonSettings, load_steps: usize) -> Result<(
 /// The Gauss points of a FEM solver, element by element (point `p = e * n_q + q`). `X` is
 /// the type of a local coordinate and of a position: `f64` for line elements,
 /// `SVector<f64, 2>` for plane elements.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct GaussPoints<X = f64> {
     /// Element of each point.
     pub element: Vec<usize>,
@@ -46,6 +46,19 @@ pub struct GaussPoints<X = f64> {
     pub mass: Vec<f64>,
     /// Committed F, volume and constitutive state.
     pub state: Vec<PointState>,
+}
+
+impl<X> Default for GaussPoints<X> {
+    fn default() -> Self {
+        Self {
+            element: vec![],
+            xi: vec![],
+            position0: vec![],
+            volume0: vec![],
+            mass: vec![],
+            state: vec![],
+        }
+    }
 }
 
 impl<X> GaussPoints<X> {

@@ -22,7 +22,7 @@
 use crate::basis::Basis;
 use crate::constitutive::{lame, LinearElastic};
 use crate::error::{require_count, require_positive, InputError, SolveError};
-use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
+use crate::fem::{ElementFamily, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
 use crate::load_stepping::{LoadStepping, StepReport};

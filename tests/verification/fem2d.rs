@@ -13,7 +13,7 @@ use crate::common;
 
 use common::Rng;
 use igimp::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
-use igimp::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
+use igimp::fem::{ElementFamily, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
 use igimp::kinematics::{left_cauchy_green_from_strain, log_strain};
 use igimp::linear::LinearSolver;
 use igimp::load_stepping::LoadStepping;

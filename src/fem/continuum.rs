@@ -1,8 +1,13 @@
-//! Plane-strain updated-Lagrangian FEM on quadrilaterals ([`PlaneFem`]): the comparator of
-//! the 2D examples (§5.2 compaction with Q4 and 2×2 Gauss points, §5.3 cantilever with Q8
-//! and 3×3). Plane strain comes from the shared kinematics, which keep F₃₃ = 1.
+//! Updated-Lagrangian FEM on tensor-product elements in 2D and 3D ([`ContinuumFem`]): the
+//! plane-strain comparator of the 2D examples ([`PlaneFem`]: §5.2 compaction with Q4 and 2×2
+//! Gauss points, §5.3 cantilever with Q8 and 3×3; plane strain comes from the shared
+//! kinematics, which keep F₃₃ = 1) and the solid comparator of the 3D examples
+//! ([`SolidFem`]: Hex8 with 2×2×2, Hex20 with 3×3×3). One generic solver, so the two differ
+//! only in their element tables.
 
-use super::quad::{PlaneMesh, QuadElement};
+use super::hex::HexElement;
+use super::mesh::{ElementFamily, ElementMesh};
+use super::quad::QuadElement;
 use super::updated_lagrangian::{
     fem_advance, fem_step_system, validate_stepping, FemMesh, GaussPoints, UlCore,
 };
@@ -15,14 +20,12 @@ use crate::newton::NewtonSettings;
 use nalgebra::{Matrix3, SVector};
 use serde::{Deserialize, Serialize};
 
-type V2 = SVector<f64, 2>;
-
-/// Settings of a [`PlaneFem`] analysis.
+/// Settings of a [`ContinuumFem`] analysis (plane or solid).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlaneFemSettings {
-    /// Gauss points per axis of the n×n rule, 1..=5; `None` for the element's default
-    /// (2 for Q4, 3 for Q8).
+    /// Gauss points per axis of the tensor rule, 1..=5; `None` for the element's default
+    /// (2 for Q4 and Hex8, 3 for Q8 and Hex20).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gauss_points: Option<usize>,
     pub newton: NewtonSettings,
@@ -55,16 +58,34 @@ impl PlaneFemSettings {
 }
 
 /// Dead loads at the end of the analysis, applied proportionally over the load steps.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct PlaneLoads {
+#[derive(Debug, Clone, PartialEq)]
+pub struct FemLoads<const D: usize> {
     /// Body force per unit mass (gravitational acceleration), carried by the Gauss point
     /// masses and mapped to the nodes with N (eq 40).
-    pub gravity: V2,
+    pub gravity: SVector<f64, D>,
     /// Point forces on nodes: (node, force). Fixed in direction (dead loads).
-    pub nodal_forces: Vec<(usize, V2)>,
+    pub nodal_forces: Vec<(usize, SVector<f64, D>)>,
 }
 
-/// Implicit updated-Lagrangian plane-strain FEM on a quadrilateral mesh.
+impl<const D: usize> Default for FemLoads<D> {
+    fn default() -> Self {
+        Self {
+            gravity: SVector::zeros(),
+            nodal_forces: vec![],
+        }
+    }
+}
+
+/// Loads of a plane-strain analysis (per unit thickness).
+pub type PlaneLoads = FemLoads<2>;
+/// Loads of a 3D analysis.
+pub type SolidLoads = FemLoads<3>;
+/// Plane-strain FEM on quadrilaterals.
+pub type PlaneFem = ContinuumFem<2, QuadElement>;
+/// 3D FEM on hexahedra.
+pub type SolidFem = ContinuumFem<3, HexElement>;
+
+/// Implicit updated-Lagrangian FEM on a mesh of one element family (plane strain in 2D).
 ///
 /// Each Gauss point is an integration point of the shared assembly: every load step fills the
 /// support table with N_a(ξ_q) and ∂N_a/∂X̃ = J⁻ᵀ ∂N_a/∂ξ on the current (start-of-step)
@@ -72,49 +93,49 @@ pub struct PlaneLoads {
 /// those of the material point solver. The Gauss point volume is the committed
 /// `PointState::volume` (w_q det J₀ times det ΔF at each commit, eq 28), equal to
 /// w_q det J on the current mesh (tested). Thickness is one: masses are per unit thickness
-/// (ρ0 w_q det J₀) and forces are per unit thickness.
-pub struct PlaneFem {
+/// (ρ0 w_q det J₀) and forces are per unit thickness; in 3D they are absolute.
+pub struct ContinuumFem<const D: usize, E> {
     /// Initial mesh.
-    pub mesh0: PlaneMesh,
+    pub mesh0: ElementMesh<D, E>,
     /// Current mesh (nodes moved with the material).
-    pub mesh: PlaneMesh,
-    pub gauss: GaussPoints<V2>,
+    pub mesh: ElementMesh<D, E>,
+    pub gauss: GaussPoints<SVector<f64, D>>,
     /// Nodal dofs with zero displacement: (node, axis).
     pub fixed: Vec<(usize, usize)>,
-    pub loads: PlaneLoads,
+    pub loads: FemLoads<D>,
     pub settings: PlaneFemSettings,
     /// `loads.nodal_forces` as (dof, force) pairs.
     dof_forces: Vec<(usize, f64)>,
-    core: UlCore<2>,
+    core: UlCore<D>,
 }
 
-impl PlaneFem {
-    /// A solver on `mesh` with density `density` (mass per unit initial area and unit
-    /// thickness).
+impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
+    /// A solver on `mesh` with density `density` (mass per unit initial volume; in 2D per
+    /// unit area and unit thickness).
     pub fn try_new(
-        mesh: PlaneMesh,
+        mesh: ElementMesh<D, E>,
         density: f64,
         model: Box<dyn ConstitutiveModel>,
         fixed: Vec<(usize, usize)>,
-        loads: PlaneLoads,
+        loads: FemLoads<D>,
         settings: PlaneFemSettings,
     ) -> Result<Self, InputError> {
         settings.validate()?;
         crate::error::require_positive("density", density)?;
-        for a in 0..2 {
+        for a in 0..D {
             require_finite(&format!("gravity[{a}]"), loads.gravity[a])?;
         }
         let nn = mesh.num_nodes();
         for &(n, a) in &fixed {
-            if n >= nn || a >= 2 {
+            if n >= nn || a >= D {
                 return Err(InputError::new(
                     "fixed dof",
                     format!("(node {n}, axis {a})"),
-                    format!("node < {nn} and axis < 2"),
+                    format!("node < {nn} and axis < {D}"),
                 ));
             }
         }
-        let mut dof_forces = Vec::with_capacity(2 * loads.nodal_forces.len());
+        let mut dof_forces = Vec::with_capacity(D * loads.nodal_forces.len());
         for &(n, f) in &loads.nodal_forces {
             if n >= nn || !f.iter().all(|v| v.is_finite()) {
                 return Err(InputError::new(
@@ -123,9 +144,9 @@ impl PlaneFem {
                     format!("node < {nn} and finite force"),
                 ));
             }
-            dof_forces.extend([(2 * n, f[0]), (2 * n + 1, f[1])]);
+            dof_forces.extend((0..D).map(|a| (D * n + a, f[a])));
         }
-        let points = QuadElement::tensor_rule(
+        let points = crate::quadrature::tensor_rule::<D>(
             settings
                 .gauss_points
                 .unwrap_or(mesh.element.default_gauss_points()),
@@ -135,7 +156,7 @@ impl PlaneFem {
         for e in 0..mesh.num_elements() {
             for (xi, w) in &points {
                 let (pos, jac) = mesh.map(e, xi);
-                gauss.push(e, *xi, pos, w * jac.determinant(), density);
+                gauss.push(e, *xi, pos, w * super::mesh::det_inverse(&jac).0, density);
             }
         }
         let mut core = UlCore::new(model, fixed.clone());
@@ -165,7 +186,7 @@ impl PlaneFem {
     }
 
     /// Supports of the last [`Self::build_supports`].
-    pub fn supports(&self) -> &SupportTable<2> {
+    pub fn supports(&self) -> &SupportTable<D> {
         &self.core.work.table
     }
 
@@ -174,7 +195,7 @@ impl PlaneFem {
     pub fn with_step_system<R>(
         &mut self,
         load_factor: f64,
-        f: impl FnOnce(&mut LoadStepSystem<'_, 2>) -> R,
+        f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
     ) -> Result<R, StepFailure> {
         fem_step_system(
             &mut self.core,
@@ -188,31 +209,31 @@ impl PlaneFem {
     }
 
     /// Displacement of node `n` since the start of the analysis.
-    pub fn displacement(&self, n: usize) -> V2 {
+    pub fn displacement(&self, n: usize) -> SVector<f64, D> {
         self.mesh.nodes[n] - self.mesh0.nodes[n]
     }
 
     /// Displacements of all nodes since the start of the analysis.
-    pub fn displacements(&self) -> Vec<V2> {
+    pub fn displacements(&self) -> Vec<SVector<f64, D>> {
         (0..self.mesh.num_nodes()).map(|n| self.displacement(n)).collect()
     }
 
     /// Current position x(ξ_q) of Gauss point `p`.
-    pub fn gauss_point_position(&self, p: usize) -> V2 {
+    pub fn gauss_point_position(&self, p: usize) -> SVector<f64, D> {
         self.mesh.map(self.gauss.element[p], &self.gauss.xi[p]).0
     }
 
-    /// Cauchy stress σ at Gauss point `p` (3×3; σ₃₃ is the out-of-plane stress).
+    /// Cauchy stress σ at Gauss point `p` (3×3; in 2D σ₃₃ is the out-of-plane stress).
     pub fn cauchy_stress(&self, p: usize) -> Matrix3<f64> {
         self.gauss.state[p].cauchy()
     }
 
-    /// Deformation gradient F at Gauss point `p` (F₃₃ = 1).
+    /// Deformation gradient F at Gauss point `p` (F₃₃ = 1 in 2D).
     pub fn deformation_gradient(&self, p: usize) -> Matrix3<f64> {
         self.gauss.state[p].f
     }
 
-    /// Current volume (area per unit thickness) of Gauss point `p`.
+    /// Current volume of Gauss point `p` (area per unit thickness in 2D).
     pub fn volume(&self, p: usize) -> f64 {
         self.gauss.state[p].volume
     }
@@ -223,7 +244,7 @@ impl PlaneFem {
     }
 }
 
-impl LoadStepping for PlaneFem {
+impl<const D: usize, E: ElementFamily<D>> LoadStepping for ContinuumFem<D, E> {
     fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
         fem_advance(
             &mut self.core,
