@@ -21,17 +21,23 @@ pub enum Method {
     FemQ4,
     /// Updated-Lagrangian FEM, 8-node quadrilaterals, 3×3 Gauss points (Figure 21).
     FemQ8,
+    /// Updated-Lagrangian FEM, 8-node hexahedra, 2×2×2 Gauss points (3D).
+    FemHex8,
+    /// Updated-Lagrangian FEM, 20-node serendipity hexahedra, 3×3×3 Gauss points (3D).
+    FemHex20,
 }
 
 impl Method {
     /// Every method, in declaration order.
-    pub const ALL: [Method; 6] = [
+    pub const ALL: [Method; 8] = [
         Method::Mpm,
         Method::Igimp,
         Method::FemLinear,
         Method::FemQuadratic,
         Method::FemQ4,
         Method::FemQ8,
+        Method::FemHex8,
+        Method::FemHex20,
     ];
 
     /// The name in study files and `results.json`.
@@ -43,6 +49,8 @@ impl Method {
             Method::FemQuadratic => "fem-quadratic",
             Method::FemQ4 => "fem-q4",
             Method::FemQ8 => "fem-q8",
+            Method::FemHex8 => "fem-hex8",
+            Method::FemHex20 => "fem-hex20",
         }
     }
 
@@ -55,6 +63,8 @@ impl Method {
             Method::FemQuadratic => "quadratic FEM",
             Method::FemQ4 => "Q4 FEM",
             Method::FemQ8 => "Q8 FEM",
+            Method::FemHex8 => "Hex8 FEM",
+            Method::FemHex20 => "Hex20 FEM",
         }
     }
 

@@ -7,7 +7,10 @@
 use crate::basis::Basis;
 use crate::constitutive::{lame, ConstitutiveModel, LinearElastic};
 use crate::error::{require_count, require_positive, InputError, SolveError};
-use crate::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
+use crate::fem::{
+    HexElement, HexMesh, LineElement, LineFem, LineFemSettings, LineLoads, LineMesh, PlaneFemSettings,
+    SolidFem, SolidLoads,
+};
 use crate::ghost::GhostSettings;
 use crate::grid::Grid;
 use crate::load_stepping::{LoadStepping, StepReport};
@@ -256,6 +259,9 @@ pub const METHODS: [Method; 4] = [
     Method::FemLinear,
     Method::FemQuadratic,
 ];
+
+/// The methods that solve the 3D column (`dimension = 3`).
+pub const METHODS_3D: [Method; 4] = [Method::Mpm, Method::Igimp, Method::FemHex8, Method::FemHex20];
 
 /// The column problem's parameters (defaults: §5.1 with W = 40,000).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -582,13 +588,21 @@ pub fn solve_column_observed(
     match (method, spec.dimension) {
         (Method::Mpm, 3) => solve_mpm_3d(spec, Basis::Mpm),
         (Method::Igimp, 3) => solve_mpm_3d(spec, Basis::Gimp),
+        (Method::FemHex8, 3) => solve_fem_3d(spec, HexElement::Hex8),
+        (Method::FemHex20, 3) => solve_fem_3d(spec, HexElement::Hex20),
         (_, 3) => Err(InputError::new(
             "dimension",
             3,
             format!(
-                "the 3D column is solved by mpm and igimp only ({} in 3D needs the Hex8/Hex20 comparators)",
+                "the 3D column is solved by {}, not {} (a 1D method)",
+                METHODS_3D.map(|m| m.name()).join(", "),
                 method.name()
             ),
+        )),
+        (Method::FemHex8 | Method::FemHex20, _) => Err(InputError::new(
+            "dimension",
+            spec.dimension,
+            format!("{} solves the 3D column (dimension = 3) only", method.name()),
         )),
         _ => match_1d(spec, method, observer),
     }
@@ -604,7 +618,7 @@ fn match_1d(
         Method::Igimp => solve_mpm_observed(spec, Basis::Gimp, observer),
         Method::FemLinear => solve_fem_observed(spec, LineElement::Linear, observer),
         Method::FemQuadratic => solve_fem_observed(spec, LineElement::Quadratic, observer),
-        Method::FemQ4 | Method::FemQ8 => Err(method.unsupported("column", &METHODS)),
+        _ => Err(method.unsupported("column", &METHODS)),
     }
 }
 
@@ -677,6 +691,54 @@ impl ColumnSpec {
         };
         LineFem::try_new(mesh, self.density, model, vec![0], loads, settings)
     }
+}
+
+/// The 3D column by updated-Lagrangian FEM: a 1 × 1 × n prism of Hex8 (2×2×2 Gauss points)
+/// or Hex20 (3×3×3) elements, `gauss_points` per axis when set, rollers on every lateral
+/// node (uniaxial strain) and the base on rollers. Every Gauss point of one level carries
+/// the value of the 1D element's Gauss point at that height (the strain is uniaxial), with
+/// volumes summing to the 1D point's, so eq (46), weighted by initial volume, is the 1D
+/// linear (Hex8) or quadratic (Hex20) FEM column's.
+fn solve_fem_3d(spec: &ColumnSpec, element: HexElement) -> Result<ColumnOutcome, InputError> {
+    spec.validate()?;
+    let size = SVector::<f64, 3>::new(1.0, 1.0, spec.length);
+    let mesh = HexMesh::cuboid(SVector::zeros(), size, [1, 1, spec.elements], element)?;
+    let mut fixed: Vec<(usize, usize)> = (0..mesh.num_nodes()).flat_map(|n| [(n, 0), (n, 1)]).collect();
+    fixed.extend(mesh.nodes_at(2, 0.0, 1e-12).into_iter().map(|n| (n, 2)));
+    let top_node = mesh.nearest_node(size);
+    let loads = SolidLoads {
+        gravity: SVector::<f64, 3>::new(0.0, 0.0, -spec.gravity()),
+        nodal_forces: vec![],
+    };
+    let settings = PlaneFemSettings {
+        gauss_points: spec.gauss_points,
+        newton: spec.newton,
+        load_steps: spec.load_steps,
+        linear_solver: Default::default(),
+    };
+    let mut fem = SolidFem::try_new(mesh, spec.density, spec.model()?, fixed, loads, settings)?;
+    let (steps, failure) = match fem.run() {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    let g = &fem.gauss;
+    let records = (0..g.len())
+        .map(|p| {
+            let st = &g.state[p];
+            let sigma = st.cauchy();
+            PointRecord {
+                z0: g.position0[p][2],
+                z: fem.gauss_point_position(p)[2],
+                volume0: g.volume0[p],
+                sigma_zz: sigma[(2, 2)],
+                sigma_xx: sigma[(0, 0)],
+                f_zz: st.f[(2, 2)],
+                plastic_multiplier: st.material.plastic_multiplier,
+            }
+        })
+        .collect();
+    let top = fem.displacement(top_node)[2];
+    Ok(ColumnOutcome::from_records(spec, records, top, steps, failure))
 }
 
 /// Run the column with updated-Lagrangian FEM. Records one [`PointRecord`] per Gauss point

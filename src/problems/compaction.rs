@@ -10,7 +10,9 @@
 use crate::basis::Basis;
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, require_positive, InputError, SolveError};
-use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
+use crate::fem::{
+    HexElement, HexMesh, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement, SolidFem, SolidLoads,
+};
 use crate::ghost::{GhostFaces, GhostSettings};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
@@ -56,6 +58,19 @@ pub struct CompactionSpec {
     /// Ghost penalty of nearly empty cells ([`crate::ghost`]).
     #[serde(default)]
     pub ghost: GhostSettings,
+    /// 2 (plane strain, the paper's) or 3: the quarter of a square block with two symmetry
+    /// planes ([`CompactionSpec::mpm_solver_3d`], [`solve_fem_3d`]). Not serialised at 2, so
+    /// 2D case hashes stay what they were.
+    #[serde(default = "two", skip_serializing_if = "is_two")]
+    pub dimension: usize,
+}
+
+fn two() -> usize {
+    2
+}
+
+fn is_two(d: &usize) -> bool {
+    *d == 2
 }
 
 impl Default for CompactionSpec {
@@ -85,12 +100,16 @@ impl Default for CompactionSpec {
                 faces: GhostFaces::Cut,
                 ..Default::default()
             },
+            dimension: 2,
         }
     }
 }
 
 impl CompactionSpec {
     pub fn validate(&self) -> Result<(), InputError> {
+        if !matches!(self.dimension, 2 | 3) {
+            return Err(InputError::new("dimension", self.dimension, "must be 2 or 3"));
+        }
         self.ghost.validate()?;
         require_positive("half_width", self.half_width)?;
         require_positive("height", self.height)?;
@@ -202,6 +221,9 @@ pub struct CompactionOutcome {
     pub max_horizontal_displacement: f64,
     /// Total number of weak-node constraints applied over all steps.
     pub weak_nodes_treated: usize,
+    /// Material points in the analysis.
+    pub num_points: usize,
+    /// Final domains: every point in 2D, the slice next to y = 0 in 3D ([`solve_mpm_3d`]).
     pub points: Vec<DomainRecord>,
 }
 
@@ -232,6 +254,7 @@ pub fn solve_mpm(spec: &CompactionSpec) -> Result<CompactionOutcome, InputError>
         })
         .collect();
     Ok(CompactionOutcome {
+        num_points: pts.len(),
         weak_nodes_treated: steps.iter().map(|s| s.weak_nodes).sum(),
         steps,
         failure,
@@ -290,8 +313,20 @@ pub fn solve_fem(spec: &CompactionSpec, element: QuadElement) -> Result<FemOutco
     })
 }
 
-/// The methods that solve the compaction.
+/// The methods that solve the plane-strain compaction.
 pub const METHODS: [Method; 4] = [Method::Igimp, Method::Mpm, Method::FemQ4, Method::FemQ8];
+
+/// The methods that solve the 3D compaction.
+pub const METHODS_3D: [Method; 4] = [Method::Igimp, Method::Mpm, Method::FemHex8, Method::FemHex20];
+
+/// The methods of a compaction in `dimension` (2 or 3).
+pub fn methods(dimension: usize) -> &'static [Method] {
+    if dimension == 3 {
+        &METHODS_3D
+    } else {
+        &METHODS
+    }
+}
 
 /// One compaction analysis, whatever the method.
 #[derive(Debug, Clone, PartialEq)]
@@ -304,13 +339,17 @@ pub struct CompactionSolution {
     pub weak_nodes_treated: usize,
     /// Material points (MPM, iGIMP) or elements (FEM).
     pub size: usize,
-    /// Final material point domains (none for FEM).
+    /// Final material point domains (none for FEM); in 3D the slice next to the symmetry
+    /// plane y = 0 ([`solve_mpm_3d`]).
     pub domains: Vec<DomainRecord>,
 }
 
 /// Solve the compaction by `method`: iGIMP or MPM weights on the material points (the
 /// method sets `spec.basis`), or Q4/Q8 FEM ([`solve_fem`]).
 pub fn solve(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution, InputError> {
+    if spec.dimension == 3 {
+        return solve_3d(spec, method);
+    }
     let basis = match method {
         Method::Igimp => Basis::Gimp,
         Method::Mpm => Basis::Mpm,
@@ -330,11 +369,11 @@ pub fn solve(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution
                 domains: vec![],
             });
         }
-        Method::FemLinear | Method::FemQuadratic => return Err(method.unsupported("compaction", &METHODS)),
+        _ => return Err(unsupported(spec, method)),
     };
     let o = solve_mpm(&CompactionSpec { basis, ..*spec })?;
     Ok(CompactionSolution {
-        size: o.points.len(),
+        size: o.num_points,
         steps: o.steps,
         failure: o.failure,
         max_horizontal_displacement: o.max_horizontal_displacement,
@@ -343,30 +382,37 @@ pub fn solve(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution
     })
 }
 
-/// One 3D compaction analysis: the quarter of a square block of side 2 × `half_width` and
-/// height `height` (symmetry planes x = 0 and y = 0, base z = 0 on rollers), on a cubic grid
-/// of `grid_extent[0]` × `grid_extent[0]` × `grid_extent[1]`, under the same gravity ramp.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Compaction3dOutcome {
-    pub steps: Vec<StepReport>,
-    pub failure: Option<SolveError>,
-    /// u_x of the bottom point at the largest x on the symmetry plane y = 0, plus half its
-    /// domain's growth along x (the measure of Figure 17, in 3D).
-    pub max_horizontal_displacement: f64,
-    pub points: usize,
+/// A method the compaction in `spec.dimension` does not have: an error naming `method` (and
+/// the dimension) with the allowed methods.
+fn unsupported(spec: &CompactionSpec, method: Method) -> InputError {
+    let problem = if spec.dimension == 3 {
+        "3D compaction (dimension = 3)"
+    } else {
+        "plane-strain compaction (dimension = 2)"
+    };
+    method.unsupported(problem, methods(spec.dimension))
 }
 
 impl CompactionSpec {
-    /// The 3D quarter-block solver of this spec (iGIMP or MPM by `spec.basis`): points
-    /// `points_per_cell`³ per cell, density 1, gravity along −z.
-    pub fn mpm_solver_3d(&self) -> Result<MpmSolver<3>, InputError> {
-        self.validate()?;
+    /// Cells of the 3D quarter block's grid, x × y × z.
+    fn grid_cells_3d(&self) -> [usize; 3] {
         let h = self.element_size;
         let (nx, nz) = (
             (self.grid_extent[0] / h).round() as usize,
             (self.grid_extent[1] / h).round() as usize,
         );
-        let grid = Grid::try_new([0.0; 3], [h; 3], [nx, nx, nz])?;
+        [nx, nx, nz]
+    }
+
+    /// The 3D quarter-block solver of this spec (iGIMP or MPM by `spec.basis`): the quarter
+    /// of a square block of side 2 × `half_width` and height `height` (symmetry planes x = 0
+    /// and y = 0 and the base z = 0 on rollers), on a cubic grid of `grid_extent[0]` ×
+    /// `grid_extent[0]` × `grid_extent[1]`, `points_per_cell`³ points per cell, density 1,
+    /// gravity along −z with the 2D unit weight.
+    pub fn mpm_solver_3d(&self) -> Result<MpmSolver<3>, InputError> {
+        self.validate()?;
+        let h = self.element_size;
+        let grid = Grid::try_new([0.0; 3], [h; 3], self.grid_cells_3d())?;
         let ppc = self.points_per_cell;
         let points = MaterialPoints::fill_box(
             &grid,
@@ -388,8 +434,12 @@ impl CompactionSpec {
     }
 }
 
-/// Run the 3D quarter block ([`CompactionSpec::mpm_solver_3d`]).
-pub fn solve_mpm_3d(spec: &CompactionSpec) -> Result<Compaction3dOutcome, InputError> {
+/// Run the 3D quarter block with material points ([`CompactionSpec::mpm_solver_3d`]). The
+/// measure is u_x of the bottom point at the largest x next to the symmetry plane y = 0 plus
+/// half its domain's growth along x (Figure 17's, in 3D); the domains recorded are the layer
+/// of points next to y = 0 (the full block's mid-plane), with (x, z) in the record's two
+/// slots and σ_zz as the vertical stress.
+pub fn solve_mpm_3d(spec: &CompactionSpec) -> Result<CompactionOutcome, InputError> {
     let mut solver = spec.mpm_solver_3d()?;
     let (steps, failure) = match solver.run() {
         Ok(s) => (s, None),
@@ -398,18 +448,106 @@ pub fn solve_mpm_3d(spec: &CompactionSpec) -> Result<Compaction3dOutcome, InputE
     let pts = &solver.points;
     let lowest = |a: usize| pts.position0.iter().map(|x| x[a]).fold(f64::INFINITY, f64::min);
     let (y0, z0) = (lowest(1), lowest(2));
-    let on_edge =
-        |p: usize| (pts.position0[p][1] - y0).abs() < 1e-12 && (pts.position0[p][2] - z0).abs() < 1e-12;
+    let in_slice = |p: usize| (pts.position0[p][1] - y0).abs() < 1e-12;
     let corner = (0..pts.len())
-        .filter(|&p| on_edge(p))
-        .max_by(|&a, &b| pts.position0[a][0].total_cmp(&pts.position0[b][0]));
-    let max_horizontal_displacement = corner.map_or(f64::NAN, |c| {
-        pts.displacement(c)[0] + (pts.half_length[c][0] - pts.half_length0[c][0])
-    });
-    Ok(Compaction3dOutcome {
+        .filter(|&p| in_slice(p) && (pts.position0[p][2] - z0).abs() < 1e-12)
+        .max_by(|&a, &b| pts.position0[a][0].total_cmp(&pts.position0[b][0]))
+        .expect("at least one point");
+    let max_horizontal_displacement =
+        pts.displacement(corner)[0] + (pts.half_length[corner][0] - pts.half_length0[corner][0]);
+    let points = (0..pts.len())
+        .filter(|&p| in_slice(p))
+        .map(|p| DomainRecord {
+            x0: [pts.position0[p][0], pts.position0[p][2]],
+            x: [pts.position[p][0], pts.position[p][2]],
+            half0: [pts.half_length0[p][0], pts.half_length0[p][2]],
+            half: [pts.half_length[p][0], pts.half_length[p][2]],
+            sigma_yy: pts.state[p].cauchy()[(2, 2)],
+            plastic_multiplier: pts.state[p].material.plastic_multiplier,
+        })
+        .collect();
+    Ok(CompactionOutcome {
+        num_points: pts.len(),
+        weak_nodes_treated: steps.iter().map(|s| s.weak_nodes).sum(),
         steps,
         failure,
         max_horizontal_displacement,
-        points: pts.len(),
+        points,
+    })
+}
+
+/// Updated-Lagrangian FEM of the 3D quarter block with the same supports (rollers on x = 0,
+/// y = 0 and the base), material and gravity ramp: Hex8 with 2×2×2 Gauss points or Hex20 with
+/// 3×3×3, LDLᵀ. The measure is u_x of the node at (half_width, 0, 0).
+pub fn solve_fem_3d(spec: &CompactionSpec, element: HexElement) -> Result<FemOutcome, InputError> {
+    spec.validate()?;
+    let h = spec.element_size;
+    let (n, nz) = (
+        (spec.half_width / h).round() as usize,
+        (spec.height / h).round() as usize,
+    );
+    let size = SVector::<f64, 3>::new(spec.half_width, spec.half_width, spec.height);
+    let mesh = HexMesh::cuboid(SVector::zeros(), size, [n, n, nz], element)?;
+    let tol = 1e-9 * h;
+    let mut fixed: Vec<(usize, usize)> = vec![];
+    for axis in 0..3 {
+        fixed.extend(mesh.nodes_at(axis, 0.0, tol).into_iter().map(|node| (node, axis)));
+    }
+    let corner = mesh.nearest_node(SVector::<f64, 3>::new(spec.half_width, 0.0, 0.0));
+    let elements = mesh.num_elements();
+    let loads = SolidLoads {
+        gravity: SVector::<f64, 3>::new(0.0, 0.0, -spec.unit_weight()),
+        nodal_forces: vec![],
+    };
+    let settings = PlaneFemSettings {
+        gauss_points: None,
+        newton: spec.newton,
+        load_steps: spec.load_steps,
+        linear_solver: LinearSolver::Ldlt,
+    };
+    let mut fem = SolidFem::try_new(mesh, 1.0, spec.model()?, fixed, loads, settings)?;
+    let (steps, failure) = match fem.run() {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    Ok(FemOutcome {
+        steps,
+        failure,
+        max_horizontal_displacement: fem.displacement(corner)[0],
+        elements,
+    })
+}
+
+/// The 3D compaction by `method` ([`solve_mpm_3d`], [`solve_fem_3d`]).
+fn solve_3d(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution, InputError> {
+    let element = match method {
+        Method::Igimp | Method::Mpm => {
+            let basis = if method == Method::Igimp {
+                Basis::Gimp
+            } else {
+                Basis::Mpm
+            };
+            let o = solve_mpm_3d(&CompactionSpec { basis, ..*spec })?;
+            return Ok(CompactionSolution {
+                size: o.num_points,
+                steps: o.steps,
+                failure: o.failure,
+                max_horizontal_displacement: o.max_horizontal_displacement,
+                weak_nodes_treated: o.weak_nodes_treated,
+                domains: o.points,
+            });
+        }
+        Method::FemHex8 => HexElement::Hex8,
+        Method::FemHex20 => HexElement::Hex20,
+        _ => return Err(unsupported(spec, method)),
+    };
+    let o = solve_fem_3d(spec, element)?;
+    Ok(CompactionSolution {
+        steps: o.steps,
+        failure: o.failure,
+        max_horizontal_displacement: o.max_horizontal_displacement,
+        weak_nodes_treated: 0,
+        size: o.elements,
+        domains: vec![],
     })
 }

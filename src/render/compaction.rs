@@ -272,9 +272,15 @@ fn render_figure(
                 CaseStatus::Converged => f.title.clone(),
                 _ => format!("{} (last converged step)", f.title),
             };
+            // The 3D study's domains are the slice next to y = 0, vertical axis z.
+            let vertical = if results.study.block.dimension == 3 {
+                "σzz"
+            } else {
+                "σyy"
+            };
             domains_svg(
                 &title,
-                "σyy",
+                vertical,
                 &[
                     DomainLayer {
                         label: "initial".into(),

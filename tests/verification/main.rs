@@ -11,6 +11,7 @@ mod compaction;
 mod elastica;
 mod fem;
 mod fem2d;
+mod fem3d;
 mod hostile;
 mod manufactured;
 mod patch;

@@ -181,7 +181,7 @@ impl StudySpec {
         c.non_empty(&k("methods"), methods)?;
         for (j, m) in methods.iter().enumerate() {
             let allowed: &[Method] = if self.dimension == 3 {
-                &[Method::Mpm, Method::Igimp]
+                &crate::problems::column::METHODS_3D
             } else {
                 &crate::problems::column::METHODS
             };

@@ -60,11 +60,15 @@ impl StudyKind for CompactionStudy {
         self.cases(tier)
     }
     fn key(&self, c: &CompactionCase) -> CaseKey {
-        CaseKey::of_spec(&c.id, c.method, &c.spec, 0)
+        let mut key = CaseKey::of_spec(&c.id, c.method, &c.spec, 0);
+        // The ParaView writer draws 2D domains; 3D cases have no VTK output yet.
+        key.has_vtk &= c.spec.dimension == 2;
+        key
     }
     fn cost(&self, c: &CompactionCase) -> f64 {
         let s = &c.spec;
-        (s.points_per_cell * s.points_per_cell) as f64 / (s.element_size * s.element_size)
+        let d = s.dimension as i32;
+        (s.points_per_cell as f64 / s.element_size).powi(d)
     }
     fn solve(&self, c: &CompactionCase, vtk: Option<&VtkTarget>) -> Result<Self::Output, StudyError> {
         let out = solve_case(c);

@@ -34,6 +34,20 @@ pub struct BlockSection {
     pub weight: f64,
     /// Gravity is ramped linearly over this many load steps.
     pub load_steps: i64,
+    /// 2 (default: plane strain, the paper's) or 3: the quarter of a square block with
+    /// symmetry planes x = 0 and y = 0 ([`CompactionSpec::dimension`]); its methods are
+    /// igimp, mpm, fem-hex8 and fem-hex20, and its domain figures show the slice next to the
+    /// symmetry plane y = 0 in the (x, z) plane.
+    #[serde(default = "two", skip_serializing_if = "is_two")]
+    pub dimension: i64,
+}
+
+fn two() -> i64 {
+    2
+}
+
+fn is_two(d: &i64) -> bool {
+    *d == 2
 }
 
 /// Quick-tier overrides of a sweep.

@@ -4,7 +4,7 @@
 
 use super::{CompactionCase, CompactionFigureKind, CompactionStudy, CompactionSweep};
 use crate::method::Method;
-use crate::problems::compaction::{CompactionSpec, METHODS};
+use crate::problems::compaction::{methods, CompactionSpec};
 use crate::study::engine::distinct_cases;
 use crate::study::results::SweepIndex;
 use crate::study::vocabulary::{max_points_per_axis, number, Checker, Header, MAX_POINTS_PER_CELL};
@@ -25,6 +25,10 @@ impl CompactionStudy {
             report_file: &self.report_file,
         })?;
         chk.count("block.load_steps", self.block.load_steps, 1, 10_000)?;
+        if !matches!(self.block.dimension, 2 | 3) {
+            return Err(chk.err("block.dimension", self.block.dimension, "must be 2 or 3"));
+        }
+        let dimension = self.block.dimension as usize;
         chk.newton("newton", &self.newton)?;
         self.ghost
             .validate()
@@ -53,7 +57,7 @@ impl CompactionStudy {
                         return Err(chk.err(k(key), "[]", "must list at least one value"));
                     }
                 }
-                let max = max_points_per_axis(2);
+                let max = max_points_per_axis(dimension as u32);
                 if let Some(&p) = plan.points_per_cell.iter().find(|&&p| !(1..=max).contains(&p)) {
                     return Err(chk.err(
                         k("points_per_cell"),
@@ -65,8 +69,15 @@ impl CompactionStudy {
                     ));
                 }
                 for (j, m) in plan.methods.iter().enumerate() {
-                    m.expect_one_of("compaction", &METHODS)
-                        .map_err(|e| chk.err(k(&format!("methods[{j}]")), m.name(), e.allowed))?;
+                    m.expect_one_of(
+                        if dimension == 3 {
+                            "3D compaction (block.dimension = 3)"
+                        } else {
+                            "plane-strain compaction (block.dimension = 2)"
+                        },
+                        methods(dimension),
+                    )
+                    .map_err(|e| chk.err(k(&format!("methods[{j}]")), m.name(), e.allowed))?;
                 }
                 for c in self.sweep_cases(s, &plan) {
                     c.spec.validate().map_err(|e| {
@@ -184,6 +195,7 @@ impl CompactionStudy {
             weak_node_tolerance: tolerance,
             weak_node_treatment: self.weak_nodes.treatment,
             ghost: self.ghost.settings(ppc, s.yield_stress.is_some(), gamma),
+            dimension: self.block.dimension as usize,
             ..CompactionSpec::default()
         }
     }
