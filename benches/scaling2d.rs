@@ -8,146 +8,28 @@
 //! residual, pattern and tangent, to measure its cost against the same run without it.
 //! `SCALING_SHIFT=<s>` translates every point by s·h in x and y first, so that the block's
 //! boundary cells are partially filled (the block starts cell-aligned: no cut faces).
-use igimp::assembly::{DofMap, LoadStepSystem};
-use igimp::ghost::{GhostFaces, GhostSettings};
-use igimp::linear::{LinearSolver, SparseSystem};
-use igimp::newton::NonlinearSystem;
+//! `SCALING_SOLVER=lu|llt|ldlt` picks the factorisation (default LDLᵀ).
+mod scaling;
+
 use igimp::problems::compaction::CompactionSpec;
 use std::time::Instant;
 
-fn peak_memory_mib() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("VmHWM:")).map(|l| l.to_string()))
-        .and_then(|l| l.split_whitespace().nth(1).and_then(|v| v.parse::<f64>().ok()))
-        .map_or(f64::NAN, |kib| kib / 1024.0)
-}
-
-fn ghost_from_env() -> GhostSettings {
-    let mut g = GhostSettings::default();
-    if let Ok(v) = std::env::var("SCALING_GHOST") {
-        let mut parts = v.split(':');
-        g.gamma = parts
-            .next()
-            .and_then(|s| s.parse().ok())
-            .expect("SCALING_GHOST=<gamma>[:all]");
-        if parts.next() == Some("all") {
-            g.faces = GhostFaces::All;
-        }
-    }
-    g
-}
-
-fn run(target: f64, solver: LinearSolver) {
+fn run(target: f64) {
     // 2×2 points per cell in the 4 × 8 half block: 128 / h² points.
     let cells_per_unit = (target / 128.0).sqrt().round().max(1.0);
     let h = 1.0 / cells_per_unit;
     let spec = CompactionSpec {
         element_size: h,
-        linear_solver: solver,
-        ghost: ghost_from_env(),
+        linear_solver: scaling::solver_from_env(),
+        ghost: scaling::ghost_from_env(),
         ..CompactionSpec::default()
     };
     let t = Instant::now();
-    let mut solver_mpm = spec.mpm_solver().expect("valid compaction");
+    let solver = spec.mpm_solver().expect("valid compaction");
     let setup = t.elapsed().as_secs_f64();
-    if let Some(shift) = std::env::var("SCALING_SHIFT")
-        .ok()
-        .and_then(|s| s.parse::<f64>().ok())
-    {
-        for x in solver_mpm.points.position.iter_mut() {
-            x.add_scalar_mut(shift * h);
-        }
-    }
-    let t = Instant::now();
-    solver_mpm.build_supports().unwrap();
-    let weights = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    solver_mpm.build_ghost();
-    let ghost_build = t.elapsed().as_secs_f64();
-    let ghost = spec.ghost.is_on().then_some(solver_mpm.ghost());
-    let table = solver_mpm.supports().clone();
-    let t = Instant::now();
-    let dofs = DofMap::build(solver_mpm.grid.num_nodes(), &table, &solver_mpm.fixed, &[]);
-    let mut matrix = SparseSystem::default();
-    let mut columns = dofs.pattern(&table);
-    if let Some(g) = ghost {
-        g.add_pattern(&dofs, &mut columns);
-    }
-    matrix.set_pattern(columns);
-    matrix.set_solver(solver);
-    let pattern = t.elapsed().as_secs_f64();
-    let f_ext = vec![1.0; dofs.len()];
-    let (mut trials, mut du) = (Vec::new(), Vec::new());
-    let mut sys = LoadStepSystem {
-        model: solver_mpm.model(),
-        states: &solver_mpm.points.state,
-        table: &table,
-        dofs: &dofs,
-        f_ext: &f_ext,
-        matrix: &mut matrix,
-        trials: &mut trials,
-        du_nodal: &mut du,
-        ghost,
-        fixed_forces: &mut Vec::new(),
-        linearised: None,
-    };
-    let u = vec![-1e-4; dofs.len()];
-    let mut r = vec![0.0; dofs.len()];
-    sys.evaluate(&u, &mut r).unwrap(); // first pass allocates the trial array
-    let t = Instant::now();
-    sys.evaluate(&u, &mut r).unwrap();
-    let constitutive = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    sys.assemble_tangent();
-    let tangent = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    sys.matrix.solve_in_place(&mut r).unwrap(); // symbolic + numeric
-    let first_solve = t.elapsed().as_secs_f64();
-    let mut r2 = vec![1.0; dofs.len()];
-    let t = Instant::now();
-    sys.matrix.solve_in_place(&mut r2).unwrap(); // numeric only (symbolic cached)
-    let solve = t.elapsed().as_secs_f64();
-    println!(
-        "{:>9} points, h = 1/{:<3} {:>8} dofs, nnz {:>9}, {:?}, ghost {} faces: setup {setup:.3} s | per iteration: weights {weights:.3} s, \
-         ghost faces+fill {ghost_build:.3} s, constitutive+residual {constitutive:.3} s, tangent assembly {tangent:.3} s, factorisation+solve {solve:.3} s \
-         (first, with symbolic: {first_solve:.3} s) | pattern {pattern:.3} s | peak memory {:.0} MiB",
-        solver_mpm.points.len(),
-        cells_per_unit,
-        dofs.len(),
-        sys.matrix.nnz(),
-        solver,
-        ghost.map_or(0, |g| g.num_faces()),
-        peak_memory_mib()
-    );
+    scaling::time_iteration(solver, spec.ghost.is_on(), spec.linear_solver, h, setup);
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with("--"))
-        .collect();
-    let sizes: Vec<f64> = if args.is_empty() {
-        vec![1e4, 1e5]
-    } else {
-        args.iter().filter_map(|a| a.parse().ok()).collect()
-    };
-    let solver = match std::env::var("SCALING_SOLVER").as_deref() {
-        Ok("lu") => LinearSolver::Lu,
-        Ok("llt") => LinearSolver::Llt,
-        _ => LinearSolver::Ldlt,
-    };
-    if sizes.len() == 1 {
-        run(sizes[0], solver);
-        return;
-    }
-    // One child process per size so that each peak-memory figure is its own.
-    let exe = std::env::current_exe().expect("bench executable");
-    for s in sizes {
-        let status = std::process::Command::new(&exe)
-            .arg(format!("{s}"))
-            .status()
-            .expect("spawn");
-        assert!(status.success(), "size {s} failed");
-    }
+    scaling::drive(&[1e4, 1e5], run);
 }

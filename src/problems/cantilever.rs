@@ -6,11 +6,22 @@
 //! vertically. The end load P (vertical, fixed direction) is split equally between the two
 //! end-most material points just above and just below the neutral axis, and applied over the
 //! load steps. The background grid extends below the beam far enough for the deflected shape.
+//!
+//! In 3D (`dimension = 3`, issue 15) the beam is `length × depth × depth` (a square section),
+//! x along the beam, y up, z across. The supports are those of 2D on the end face x = 0 (u_x = 0
+//! on every node, u_y = 0 along its neutral-axis line), plus u_z = 0 on the mid-plane
+//! z = depth / 2, which is exact by symmetry and removes the rigid motions across. The end
+//! load is split equally over the end-most points of the two rows straddling the neutral axis,
+//! across the whole width (a line load); Hex8/Hex20 FEM carry it as the consistent line load on
+//! the end edge along the neutral axis.
 
 use crate::basis::Basis;
 use crate::constitutive::LinearElastic;
 use crate::error::{require_count, require_positive, InputError, SolveError};
-use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
+use crate::fem::{
+    ElementFamily, FemLoads, HexElement, HexMesh, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh,
+    QuadElement, SolidFem,
+};
 use crate::ghost::{GhostFaces, GhostSettings};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
@@ -57,6 +68,18 @@ pub struct CantileverSpec {
     /// Ghost penalty of nearly empty cells ([`crate::ghost`]).
     #[serde(default)]
     pub ghost: GhostSettings,
+    /// 2 (plane strain, the paper's) or 3 (a `depth × depth` section; see the module docs).
+    /// Not serialised at 2, so 2D case hashes stay what they were.
+    #[serde(default = "two", skip_serializing_if = "is_two")]
+    pub dimension: usize,
+}
+
+fn two() -> usize {
+    2
+}
+
+fn is_two(d: &usize) -> bool {
+    *d == 2
 }
 
 impl Default for CantileverSpec {
@@ -86,12 +109,16 @@ impl Default for CantileverSpec {
                 faces: GhostFaces::Cut,
                 cut_fill: 0.05,
             },
+            dimension: 2,
         }
     }
 }
 
 impl CantileverSpec {
     pub fn validate(&self) -> Result<(), InputError> {
+        if !matches!(self.dimension, 2 | 3) {
+            return Err(InputError::new("dimension", self.dimension, "must be 2 or 3"));
+        }
         self.ghost.validate()?;
         require_positive("length", self.length)?;
         require_positive("depth", self.depth)?;
@@ -143,7 +170,23 @@ impl CantileverSpec {
         Ok(())
     }
 
-    /// The solver, and the indices of the two loaded points (below, above the neutral axis).
+    /// Solver settings of the material point beam (2D or 3D).
+    fn mpm_settings(&self) -> MpmSettings {
+        MpmSettings {
+            basis: Basis::Gimp,
+            domain_update: self.domain_update,
+            newton: self.newton,
+            load_steps: self.load_steps,
+            weak_node_tolerance: self.weak_node_tolerance,
+            weak_node_treatment: self.weak_node_treatment,
+            volume_update: self.volume_update,
+            linear_solver: Default::default(),
+            ghost: self.ghost,
+        }
+    }
+
+    /// The plane-strain solver, and the indices of the two loaded points (below, above the
+    /// neutral axis).
     pub fn mpm_solver(&self) -> Result<(MpmSolver<2>, [usize; 2]), InputError> {
         self.validate()?;
         let h = self.element_size;
@@ -161,40 +204,82 @@ impl CantileverSpec {
             .find(|&n| (grid.node_position(n)[1] - axis_y).abs() < 1e-9 * h)
             .expect("neutral axis node");
         fixed.push((pin, 1));
-        // End-most column of points; the two nearest the neutral axis.
-        let x_end = points.position0.iter().map(|x| x[0]).fold(f64::MIN, f64::max);
-        let mut end: Vec<usize> = (0..points.len())
-            .filter(|&p| (points.position0[p][0] - x_end).abs() < 1e-9)
-            .collect();
-        end.sort_by(|&a, &b| {
-            (points.position0[a][1] - axis_y)
-                .abs()
-                .total_cmp(&(points.position0[b][1] - axis_y).abs())
-        });
-        let mut loaded = [end[0], end[1]];
-        loaded.sort_by(|&a, &b| points.position0[a][1].total_cmp(&points.position0[b][1]));
+        let loaded = end_points_at_axis(&points, axis_y);
+        let loaded = [loaded[0], loaded[1]];
         let force = SVector::<f64, 2>::new(0.0, -0.5 * self.load);
         let loads = Loads {
             gravity: SVector::<f64, 2>::zeros(),
             point_loads: vec![(loaded[0], force), (loaded[1], force)],
         };
-        let settings = MpmSettings {
-            basis: Basis::Gimp,
-            domain_update: self.domain_update,
-            newton: self.newton,
-            load_steps: self.load_steps,
-            weak_node_tolerance: self.weak_node_tolerance,
-            weak_node_treatment: self.weak_node_treatment,
-            volume_update: self.volume_update,
-            linear_solver: Default::default(),
-            ghost: self.ghost,
-        };
         let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
         Ok((
-            MpmSolver::try_new(grid, points, model, fixed, loads, settings)?,
+            MpmSolver::try_new(grid, points, model, fixed, loads, self.mpm_settings())?,
             loaded,
         ))
     }
+
+    /// The 3D solver (module docs), and the loaded points: the end-most points of the two rows
+    /// straddling the neutral axis, across the width, in order of (y, z).
+    pub fn mpm_solver_3d(&self) -> Result<(MpmSolver<3>, Vec<usize>), InputError> {
+        self.validate()?;
+        let h = self.element_size;
+        let m = self.grid_margin;
+        let cells = [
+            ((self.length + m) / h).round() as usize,
+            ((self.grid_below + self.depth + m) / h).round() as usize,
+            ((self.depth + 2.0 * m) / h).round() as usize,
+        ];
+        let grid = Grid::try_new([0.0, -self.grid_below, -m], [h; 3], cells)?;
+        let ppc = self.points_per_cell;
+        let d = self.depth;
+        let points = MaterialPoints::fill_box(&grid, [0.0; 3], [self.length, d, d], [ppc; 3], 1.0)?;
+        let (axis_y, mid_z) = (0.5 * d, 0.5 * d);
+        let on = |n: usize, a: usize, v: f64| (grid.node_position(n)[a] - v).abs() < 1e-9 * h;
+        let mut fixed: Vec<(usize, usize)> = vec![];
+        for n in grid.nodes_on_plane(0, 0.0) {
+            fixed.push((n, 0));
+            if on(n, 1, axis_y) {
+                fixed.push((n, 1));
+            }
+        }
+        fixed.extend((0..grid.num_nodes()).filter(|&n| on(n, 2, mid_z)).map(|n| (n, 2)));
+        let loaded = end_points_at_axis(&points, axis_y);
+        let force = SVector::<f64, 3>::new(0.0, -self.load / loaded.len() as f64, 0.0);
+        let loads = Loads {
+            gravity: SVector::<f64, 3>::zeros(),
+            point_loads: loaded.iter().map(|&p| (p, force)).collect(),
+        };
+        let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
+        Ok((
+            MpmSolver::try_new(grid, points, model, fixed, loads, self.mpm_settings())?,
+            loaded,
+        ))
+    }
+}
+
+/// The end-most points (largest initial x) of the two rows nearest the neutral axis y =
+/// `axis_y`, ordered by initial y, then z.
+fn end_points_at_axis<const D: usize>(points: &MaterialPoints<D>, axis_y: f64) -> Vec<usize> {
+    let x0 = |p: usize| points.position0[p];
+    let x_end = points.position0.iter().map(|x| x[0]).fold(f64::MIN, f64::max);
+    let end: Vec<usize> = (0..points.len())
+        .filter(|&p| (x0(p)[0] - x_end).abs() < 1e-9)
+        .collect();
+    let gap = end
+        .iter()
+        .map(|&p| (x0(p)[1] - axis_y).abs())
+        .fold(f64::INFINITY, f64::min);
+    let mut loaded: Vec<usize> = end
+        .into_iter()
+        .filter(|&p| ((x0(p)[1] - axis_y).abs() - gap).abs() < 1e-9)
+        .collect();
+    loaded.sort_by(|&a, &b| {
+        let (xa, xb) = (x0(a), x0(b));
+        (xa[1], xa[D - 1])
+            .partial_cmp(&(xb[1], xb[D - 1]))
+            .expect("finite positions")
+    });
+    loaded
 }
 
 /// End displacement after one converged load step.
@@ -222,19 +307,22 @@ pub struct CantileverOutcome {
     pub steps: Vec<StepReport>,
     pub end: Vec<EndDisplacement>,
     pub failure: Option<SolveError>,
-    /// Snapshots at the start and after every `snapshot_every` steps (and the last).
+    /// Snapshots at the start and after every `snapshot_every` steps (and the last): every
+    /// point in 2D, in 3D the layer of points next to the mid-plane z = depth/2 (x, y only).
     pub snapshots: Vec<DomainSnapshot>,
-    /// Smallest domain half-length (either axis) over all points after each step.
+    /// Smallest domain half-length (any axis) over all points after each step.
     pub min_half_length: Vec<f64>,
-    pub loaded_points: [usize; 2],
+    /// The loaded points, as indices into the snapshots' domains.
+    pub loaded_points: Vec<usize>,
 }
 
-fn snapshot(solver: &MpmSolver<2>, step: usize) -> DomainSnapshot {
+fn snapshot<const D: usize>(solver: &MpmSolver<D>, shown: &[usize], step: usize) -> DomainSnapshot {
     let p = &solver.points;
     DomainSnapshot {
         step,
-        domains: (0..p.len())
-            .map(|i| {
+        domains: shown
+            .iter()
+            .map(|&i| {
                 [
                     p.position[i][0],
                     p.position[i][1],
@@ -246,21 +334,56 @@ fn snapshot(solver: &MpmSolver<2>, step: usize) -> DomainSnapshot {
     }
 }
 
-/// Run the cantilever with iGIMP, recording the end displacement after every step.
+/// Run the cantilever with iGIMP (2D or 3D by `spec.dimension`), recording the end
+/// displacement after every step.
 pub fn solve_mpm(spec: &CantileverSpec, snapshot_every: usize) -> Result<CantileverOutcome, InputError> {
-    let (mut solver, loaded) = spec.mpm_solver()?;
+    if spec.dimension == 3 {
+        let (solver, loaded) = spec.mpm_solver_3d()?;
+        // The layer just below the mid-plane z = d/2.
+        let p0 = &solver.points.position0;
+        let mid = 0.5 * spec.depth;
+        let z = p0
+            .iter()
+            .map(|x| x[2])
+            .filter(|&z| z < mid)
+            .fold(f64::MIN, f64::max);
+        let shown: Vec<usize> = (0..p0.len()).filter(|&p| (p0[p][2] - z).abs() < 1e-12).collect();
+        run_mpm(spec, solver, &loaded, shown, snapshot_every)
+    } else {
+        let (solver, loaded) = spec.mpm_solver()?;
+        let shown = (0..solver.points.len()).collect();
+        run_mpm(spec, solver, &loaded, shown, snapshot_every)
+    }
+}
+
+fn run_mpm<const D: usize>(
+    spec: &CantileverSpec,
+    mut solver: MpmSolver<D>,
+    loaded: &[usize],
+    shown: Vec<usize>,
+    snapshot_every: usize,
+) -> Result<CantileverOutcome, InputError> {
     let mut out = CantileverOutcome {
         steps: vec![],
         end: vec![],
         failure: None,
-        snapshots: vec![snapshot(&solver, 0)],
+        snapshots: vec![snapshot(&solver, &shown, 0)],
         min_half_length: vec![],
-        loaded_points: loaded,
+        loaded_points: shown
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| loaded.contains(p))
+            .map(|(i, _)| i)
+            .collect(),
     };
     while solver.steps_done() < solver.load_steps() {
         match solver.step() {
             Ok(r) => {
-                let d = (solver.points.displacement(loaded[0]) + solver.points.displacement(loaded[1])) * 0.5;
+                let d = loaded
+                    .iter()
+                    .map(|&p| solver.points.displacement(p))
+                    .sum::<SVector<f64, D>>()
+                    / loaded.len() as f64;
                 out.end.push(EndDisplacement {
                     step: r.step,
                     load: spec.load * r.load_factor,
@@ -272,16 +395,16 @@ pub fn solve_mpm(spec: &CantileverSpec, snapshot_every: usize) -> Result<Cantile
                         .points
                         .half_length
                         .iter()
-                        .map(|h| h[0].min(h[1]))
+                        .map(|h| h.min())
                         .fold(f64::INFINITY, f64::min),
                 );
                 if snapshot_every > 0 && (r.step % snapshot_every == 0 || r.step == solver.load_steps()) {
-                    out.snapshots.push(snapshot(&solver, r.step));
+                    out.snapshots.push(snapshot(&solver, &shown, r.step));
                 }
                 out.steps.push(r);
             }
             Err(e) => {
-                out.snapshots.push(snapshot(&solver, solver.steps_done()));
+                out.snapshots.push(snapshot(&solver, &shown, solver.steps_done()));
                 out.failure = Some(e);
                 break;
             }
@@ -290,7 +413,7 @@ pub fn solve_mpm(spec: &CantileverSpec, snapshot_every: usize) -> Result<Cantile
     Ok(out)
 }
 
-/// What the Q8 comparator reports: the steps and the end displacement after each.
+/// What a FEM comparator reports: the steps and the end displacement after each.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FemOutcome {
     pub steps: Vec<StepReport>,
@@ -303,6 +426,7 @@ pub struct FemOutcome {
 /// and the end load as a dead nodal force on the neutral-axis end node, as in the paper
 /// (Figure 21). The end displacement is that node's.
 pub fn solve_fem_q8(spec: &CantileverSpec) -> Result<FemOutcome, InputError> {
+    spec.validate()?;
     let h = spec.element_size;
     let cells = (
         (spec.length / h).round() as usize,
@@ -326,14 +450,84 @@ pub fn solve_fem_q8(spec: &CantileverSpec) -> Result<FemOutcome, InputError> {
         gravity: SVector::<f64, 2>::zeros(),
         nodal_forces: vec![(tip, SVector::<f64, 2>::new(0.0, -spec.load))],
     };
-    let settings = PlaneFemSettings {
-        gauss_points: Some(3),
+    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    let fem = PlaneFem::try_new(mesh, 1.0, model, fixed, loads, fem_settings(spec, Some(3)))?;
+    Ok(run_fem(spec, fem, tip))
+}
+
+/// Updated-Lagrangian Hex8 (2×2×2 Gauss points) or Hex20 (3×3×3) FEM of the 3D beam on the
+/// same `h` (20 × 2 × 2 elements for the paper's beam), the supports of the module docs (u_x
+/// on the end face, u_y along its neutral-axis line, u_z on the mid-plane), and the end load
+/// as the consistent line load on the end edge along the neutral axis (per element edge
+/// ½, ½ for Hex8; ⅙, ⅔, ⅙ for Hex20). The end displacement is that of the edge's middle
+/// node (L, d/2, d/2).
+pub fn solve_fem_3d(spec: &CantileverSpec, element: HexElement) -> Result<FemOutcome, InputError> {
+    spec.validate()?;
+    let (h, d) = (spec.element_size, spec.depth);
+    let n = |v: f64| (v / h).round() as usize;
+    let mesh = HexMesh::cuboid(
+        SVector::zeros(),
+        SVector::<f64, 3>::new(spec.length, d, d),
+        [n(spec.length), n(d), n(d)],
+        element,
+    )?;
+    let tol = 1e-9 * h;
+    let (axis, mid) = (0.5 * d, 0.5 * d);
+    let mut fixed: Vec<(usize, usize)> = vec![];
+    for node in mesh.nodes_at(0, 0.0, tol) {
+        fixed.push((node, 0));
+        if (mesh.nodes[node][1] - axis).abs() <= tol {
+            fixed.push((node, 1));
+        }
+    }
+    fixed.extend(mesh.nodes_at(2, mid, tol).into_iter().map(|node| (node, 2)));
+    let edge = mesh.nodes_on_segment(
+        SVector::<f64, 3>::new(spec.length, axis, 0.0),
+        SVector::<f64, 3>::new(spec.length, axis, d),
+        tol,
+    );
+    let weights: &[f64] = if element.quadratic() {
+        &[1.0 / 6.0, 4.0 / 6.0, 1.0 / 6.0]
+    } else {
+        &[0.5, 0.5]
+    };
+    let per_edge = weights.len() - 1;
+    let mut force = vec![0.0; edge.len()];
+    let edges = (edge.len() - 1) / per_edge;
+    for e in 0..edges {
+        for (k, w) in weights.iter().enumerate() {
+            force[e * per_edge + k] += w * spec.load / edges as f64;
+        }
+    }
+    let tip = mesh.nearest_node(SVector::<f64, 3>::new(spec.length, axis, mid));
+    let loads = FemLoads {
+        gravity: SVector::<f64, 3>::zeros(),
+        nodal_forces: edge
+            .iter()
+            .zip(&force)
+            .map(|(&node, &f)| (node, SVector::<f64, 3>::new(0.0, -f, 0.0)))
+            .collect(),
+    };
+    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    let fem = SolidFem::try_new(mesh, 1.0, model, fixed, loads, fem_settings(spec, None))?;
+    Ok(run_fem(spec, fem, tip))
+}
+
+fn fem_settings(spec: &CantileverSpec, gauss_points: Option<usize>) -> PlaneFemSettings {
+    PlaneFemSettings {
+        gauss_points,
         newton: spec.newton,
         load_steps: spec.load_steps,
         linear_solver: LinearSolver::Ldlt,
-    };
-    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
-    let mut fem = PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings)?;
+    }
+}
+
+/// Run a FEM beam step by step, recording the displacement of node `tip`.
+fn run_fem<const D: usize, E: ElementFamily<D>>(
+    spec: &CantileverSpec,
+    mut fem: crate::fem::ContinuumFem<D, E>,
+    tip: usize,
+) -> FemOutcome {
     let mut out = FemOutcome {
         steps: vec![],
         end: vec![],
@@ -357,11 +551,23 @@ pub fn solve_fem_q8(spec: &CantileverSpec) -> Result<FemOutcome, InputError> {
             }
         }
     }
-    Ok(out)
+    out
 }
 
-/// The methods that solve the cantilever.
+/// The methods that solve the plane-strain cantilever.
 pub const METHODS: [Method; 2] = [Method::Igimp, Method::FemQ8];
+
+/// The methods that solve the 3D cantilever.
+pub const METHODS_3D: [Method; 3] = [Method::Igimp, Method::FemHex8, Method::FemHex20];
+
+/// The methods of a cantilever in `dimension` (2 or 3).
+pub fn methods(dimension: usize) -> &'static [Method] {
+    if dimension == 3 {
+        &METHODS_3D
+    } else {
+        &METHODS
+    }
+}
 
 /// One cantilever analysis, whatever the method.
 #[derive(Debug, Clone, PartialEq)]
@@ -369,21 +575,31 @@ pub struct CantileverSolution {
     pub steps: Vec<StepReport>,
     pub end: Vec<EndDisplacement>,
     pub failure: Option<SolveError>,
-    /// iGIMP only: snapshots, the smallest half-length after each step, the loaded points.
+    /// iGIMP only: snapshots, the smallest half-length after each step, the loaded points
+    /// (indices into the snapshots' domains).
     pub snapshots: Vec<DomainSnapshot>,
     pub min_half_length: Vec<f64>,
-    pub loaded_points: Option<[usize; 2]>,
+    pub loaded_points: Option<Vec<usize>>,
 }
 
 /// Solve the cantilever by `method`: iGIMP ([`solve_mpm`], snapshots every
-/// `snapshot_every` steps) or Q8 FEM ([`solve_fem_q8`]).
+/// `snapshot_every` steps), Q8 FEM in 2D ([`solve_fem_q8`]), Hex8 or Hex20 FEM in 3D
+/// ([`solve_fem_3d`]).
 pub fn solve(
     spec: &CantileverSpec,
     method: Method,
     snapshot_every: usize,
 ) -> Result<CantileverSolution, InputError> {
-    match method {
-        Method::Igimp => solve_mpm(spec, snapshot_every).map(|o| CantileverSolution {
+    let fem = |o: FemOutcome| CantileverSolution {
+        steps: o.steps,
+        end: o.end,
+        failure: o.failure,
+        snapshots: vec![],
+        min_half_length: vec![],
+        loaded_points: None,
+    };
+    match (method, spec.dimension) {
+        (Method::Igimp, _) => solve_mpm(spec, snapshot_every).map(|o| CantileverSolution {
             steps: o.steps,
             end: o.end,
             failure: o.failure,
@@ -391,14 +607,16 @@ pub fn solve(
             min_half_length: o.min_half_length,
             loaded_points: Some(o.loaded_points),
         }),
-        Method::FemQ8 => solve_fem_q8(spec).map(|o| CantileverSolution {
-            steps: o.steps,
-            end: o.end,
-            failure: o.failure,
-            snapshots: vec![],
-            min_half_length: vec![],
-            loaded_points: None,
-        }),
-        _ => Err(method.unsupported("cantilever", &METHODS)),
+        (Method::FemQ8, 2) => solve_fem_q8(spec).map(fem),
+        (Method::FemHex8, 3) => solve_fem_3d(spec, HexElement::Hex8).map(fem),
+        (Method::FemHex20, 3) => solve_fem_3d(spec, HexElement::Hex20).map(fem),
+        _ => Err(method.unsupported(
+            if spec.dimension == 3 {
+                "3D cantilever (dimension = 3)"
+            } else {
+                "plane-strain cantilever (dimension = 2)"
+            },
+            methods(spec.dimension),
+        )),
     }
 }

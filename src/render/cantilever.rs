@@ -38,7 +38,16 @@ pub fn report_markdown(results: &CantileverResults) -> String {
         study.summary,
         results.provenance.line()
     );
-    s.push_str("## End displacement at the full load\n\nMean of the two loaded points (iGIMP); Δ = (continuum − elastica)/|elastica| against the plane-strain elastica of the same beam.\n\n");
+    let _ = write!(
+        s,
+        "## End displacement at the full load\n\nMean of the loaded points (iGIMP; FEM: the loaded node{}); Δ = (continuum − elastica)/|elastica| against the elastica of the same beam ({}).\n\n",
+        if results.study.beam.dimension == 3 {
+            " in the middle of the loaded edge"
+        } else {
+            ""
+        },
+        elastica_label(results, results.study.beam.dimension == 2)
+    );
     s.push_str("| case | method | domain / volume update | status | steps | u/L | v/L | elastica u/L | elastica v/L | Δu | Δv |\n|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
     for r in &results.cases {
         let _ = writeln!(
@@ -65,8 +74,8 @@ pub fn report_markdown(results: &CantileverResults) -> String {
     for p in &results.measures.elastica {
         let _ = writeln!(
             s,
-            "Elastica, plane {}: EI = {:.6e} N·m, α = PL²/EI = {:.4} at the full load.\n",
-            if p.plane_strain { "strain" } else { "stress" },
+            "Elastica, {}: EI = {:.6e} N·m, α = PL²/EI = {:.4} at the full load.\n",
+            elastica_label(results, p.plane_strain),
             p.bending_stiffness,
             p.points.last().map_or(f64::NAN, |e| e.alpha)
         );
@@ -190,7 +199,7 @@ fn render_figure(
                     colour: (s.step != 0).then_some(if wanted.len() <= 2 { 0 } else { i.min(last) }),
                 })
                 .collect();
-            let marks: Vec<PointMarks> = match (f.mark_loads, rec.loaded_points) {
+            let marks: Vec<PointMarks> = match (f.mark_loads, &rec.loaded_points) {
                 (true, Some(lp)) => vec![PointMarks {
                     label: "loaded points".into(),
                     points: wanted
@@ -212,11 +221,7 @@ fn render_figure(
         CantileverFigureKind::EndDisplacement => {
             let mut series = vec![];
             for p in &results.measures.elastica {
-                let plane = if p.plane_strain {
-                    "plane strain"
-                } else {
-                    "plane stress"
-                };
+                let plane = elastica_label(results, p.plane_strain);
                 for (name, pick) in [("u/L", 0), ("v/L", 1)] {
                     series.push(XySeries {
                         label: format!("elastica ({plane}) {name}"),
@@ -283,4 +288,13 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
         std::iter::empty(),
         r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
     ))
+}
+
+/// What an elastica path stands for: plane strain or stress in 2D, the square section in 3D.
+fn elastica_label(results: &CantileverResults, plane_strain: bool) -> &'static str {
+    match (results.study.beam.dimension, plane_strain) {
+        (3, _) => "3D, EI = E d⁴/12",
+        (_, true) => "plane strain",
+        (_, false) => "plane stress",
+    }
 }

@@ -4,7 +4,7 @@
 use crate::method::Method;
 use crate::plot2d::{domains_svg, xy_svg, Domain, DomainLayer, LegendCorner, XyAxes, XySeries};
 use crate::study::compaction::*;
-use crate::study::vocabulary::{number, GhostFaces, ResidualNorm};
+use crate::study::vocabulary::{number, points_grid, GhostFaces, ResidualNorm};
 type Results = CompactionResults;
 use super::{checks_markdown, failures_markdown, IndexEntry};
 use crate::study::checks::check_counts;
@@ -18,8 +18,11 @@ fn e3(x: Option<f64>) -> String {
     x.map_or("—".into(), |v| format!("{v:.3e}"))
 }
 
-fn ppc_label(p: usize) -> String {
-    format!("{p}×{p} points/cell")
+fn ppc_label(results: &CompactionResults, p: usize) -> String {
+    format!(
+        "{} points/cell",
+        points_grid(p, results.study.block.dimension as usize)
+    )
 }
 
 /// Table 2 / Table 3: this code's residuals beside the paper's, per step and iteration.
@@ -101,7 +104,7 @@ fn figure17_table(results: &CompactionResults) -> String {
         reference.map_or("no converged case", |r| r.description.as_str())
     );
     for p in &ppcs {
-        let _ = write!(s, " iGIMP {} |", ppc_label(*p));
+        let _ = write!(s, " iGIMP {} |", ppc_label(results, *p));
     }
     for m in &fems {
         let _ = write!(s, " {} |", m.label());
@@ -166,7 +169,10 @@ fn cases_table(results: &CompactionResults) -> String {
             c.id,
             c.method.label(),
             c.h,
-            c.points_per_cell.map_or("—".into(), |p| format!("{p}×{p}")),
+            c.points_per_cell.map_or("—".into(), |p| points_grid(
+                p,
+                results.study.block.dimension as usize
+            )),
             c.yield_stress.map_or("elastic".into(), number),
             c.weak_node_tolerance,
             if c.method.is_fem() {
@@ -364,7 +370,7 @@ fn render_figure(
                 .into_iter()
                 .map(|((m, p), pts)| XySeries {
                     label: match p {
-                        Some(p) => format!("{}, {}", m.label(), ppc_label(p)),
+                        Some(p) => format!("{}, {}", m.label(), ppc_label(results, p)),
                         None => m.label().to_string(),
                     },
                     points: pts,

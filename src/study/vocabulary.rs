@@ -300,3 +300,8 @@ pub fn parse_toml<T: DeserializeOwned>(text: &str, file: &str) -> Result<T, Stud
         message: e.to_string().trim_end().to_string(),
     })
 }
+
+/// Points per cell as a grid, `p` per axis in `dimension` axes: "2×2" in 2D, "2×2×2" in 3D.
+pub fn points_grid(p: usize, dimension: usize) -> String {
+    vec![p.to_string(); dimension.max(1)].join("×")
+}

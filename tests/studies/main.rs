@@ -6,4 +6,5 @@ mod column3d_study;
 mod compaction_study;
 mod manufactured_study;
 mod study;
+mod three_d_studies;
 mod usability;

@@ -31,7 +31,15 @@ pub(super) fn compute_checks(results: &CantileverResults) -> Vec<CheckRecord> {
         let c = results.case(&e.case);
         out.push(check_at_most(
             &format!("{}-vs-elastica", e.case),
-            format!("largest abs(Δ)/abs(elastica) of the final u/L, v/L of `{}` against the plane-strain elastica", e.case),
+            format!(
+                "largest abs(Δ)/abs(elastica) of the final u/L, v/L of `{}` against the {}",
+                e.case,
+                if results.study.beam.dimension == 3 {
+                    "3D elastica (EI = E d⁴/12)"
+                } else {
+                    "plane-strain elastica"
+                }
+            ),
             c.and_then(|c| largest_difference(c.difference_u, c.difference_v)),
             e.tolerance,
             &e.source,

@@ -14,8 +14,13 @@ use crate::study::vtk_output::{write_domain_frames, DomainFrame};
 use crate::study::{StudyError, Tier};
 use std::path::Path;
 
+/// The elastica of the beam: plane strain (EI = E/(1 − ν²) d³/12 per unit width) or plane
+/// stress (E d³/12 per unit width), which for the 3D beam's square section, times the width
+/// d, is its EI = E d⁴/12 under a load P that is the total.
 pub(super) fn elastica_path(spec: &CantileverSpec, plane_strain: bool) -> Option<ElasticaPath> {
-    let ei = bending_stiffness(spec.young_modulus, spec.poisson_ratio, spec.depth, plane_strain).ok()?;
+    let width = if spec.dimension == 3 { spec.depth } else { 1.0 };
+    let ei =
+        width * bending_stiffness(spec.young_modulus, spec.poisson_ratio, spec.depth, plane_strain).ok()?;
     let beam = Elastica::try_new(spec.length, ei).ok()?;
     let loads = crate::problems::elastica::load_steps(spec.load, spec.load_steps);
     let tips = beam.load_path(&loads).ok()?;
@@ -46,7 +51,7 @@ fn solve_case_snapshots(
         Err(e) => (SolveRecord::rejected(e), None),
         Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
     };
-    let elastica = elastica_path(s, true).and_then(|p| p.points.last().copied());
+    let elastica = elastica_path(s, s.dimension == 2).and_then(|p| p.points.last().copied());
     let (end, min_half_length, loaded_points, mut snaps) = match o {
         Some(o) => (o.end, o.min_half_length, o.loaded_points, o.snapshots),
         None => (vec![], vec![], None, vec![]),
@@ -94,10 +99,14 @@ impl StudyKind for CantileverStudy {
         (self.cases(tier), SweepIndex::new())
     }
     fn key(&self, c: &CantileverCase) -> CaseKey {
-        CaseKey::of_spec(&c.id, c.method, &c.spec, c.snapshot_every)
+        let mut key = CaseKey::of_spec(&c.id, c.method, &c.spec, c.snapshot_every);
+        // The ParaView writer draws 2D domains; 3D cases have no VTK output yet.
+        key.has_vtk &= c.spec.dimension == 2;
+        key
     }
     fn cost(&self, c: &CantileverCase) -> f64 {
-        (c.spec.length / c.spec.element_size) * (c.spec.points_per_cell as f64).powi(2)
+        let d = c.spec.dimension as i32;
+        (c.spec.length / c.spec.element_size) * (c.spec.points_per_cell as f64).powi(d)
     }
     /// With `--vtk` every iGIMP case takes snapshots: its figure's interval, else
     /// `--vtk-every`, else only the initial and final states.
@@ -124,8 +133,8 @@ impl StudyKind for CantileverStudy {
     fn measure(results: &mut Results<Self>) {
         let study = &results.study;
         let base = study.base_spec();
-        let mut elastica: Vec<ElasticaPath> = elastica_path(&base, true).into_iter().collect();
-        if study.plane_stress_elastica {
+        let mut elastica: Vec<ElasticaPath> = elastica_path(&base, base.dimension == 2).into_iter().collect();
+        if study.plane_stress_elastica && base.dimension == 2 {
             elastica.extend(elastica_path(&base, false));
         }
         let depth_study = super::checks::depth_rows(study, &results.cases);

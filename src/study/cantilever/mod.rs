@@ -40,6 +40,19 @@ pub struct BeamSection {
     /// Background grid below the beam and beyond its end/top (room for the deflection).
     pub grid_below: f64,
     pub grid_margin: f64,
+    /// 2 (default: plane strain, the paper's) or 3: a `depth × depth` section
+    /// ([`CantileverSpec::dimension`]), methods igimp, fem-hex8 and fem-hex20, the elastica
+    /// with EI = E d⁴/12, domain figures of the layer next to the mid-plane z = d/2.
+    #[serde(default = "two", skip_serializing_if = "is_two")]
+    pub dimension: i64,
+}
+
+fn two() -> i64 {
+    2
+}
+
+fn is_two(d: &i64) -> bool {
+    *d == 2
 }
 
 /// One analysis of the beam.

@@ -2,7 +2,7 @@
 //! cases (P ∝ depth³, h ∝ depth) of a tier.
 
 use super::{CantileverCase, CantileverFigureKind, CantileverStudy, CaseSection};
-use crate::problems::cantilever::{CantileverSpec, METHODS};
+use crate::problems::cantilever::{methods, CantileverSpec};
 use crate::study::vocabulary::{max_points_per_axis, Checker, Header};
 use crate::study::{StudyError, Tier};
 use std::collections::BTreeSet;
@@ -20,18 +20,29 @@ impl CantileverStudy {
         })?;
         let b = &self.beam;
         chk.count("beam.load_steps", b.load_steps, 1, 10_000)?;
+        if !matches!(b.dimension, 2 | 3) {
+            return Err(chk.err("beam.dimension", b.dimension, "must be 2 or 3"));
+        }
+        let dimension = b.dimension as usize;
         chk.count(
             "beam.points_per_cell",
             b.points_per_cell,
             1,
-            max_points_per_axis(2),
+            max_points_per_axis(dimension as u32),
         )?;
         chk.newton("newton", &self.newton)?;
         let mut ids = BTreeSet::new();
         for (i, c) in self.cases.iter().enumerate() {
             chk.unique_ident(&format!("cases[{i}].id"), &c.id, &mut ids)?;
             c.method
-                .expect_one_of("cantilever", &METHODS)
+                .expect_one_of(
+                    if dimension == 3 {
+                        "3D cantilever (beam.dimension = 3)"
+                    } else {
+                        "plane-strain cantilever (beam.dimension = 2)"
+                    },
+                    methods(dimension),
+                )
                 .map_err(|e| chk.err(format!("cases[{i}].method"), c.method.name(), e.allowed))?;
             chk.count(&format!("cases[{i}].snapshot_every"), c.snapshot_every, 0, 10_000)?;
         }
@@ -134,6 +145,7 @@ impl CantileverStudy {
             ghost: self
                 .ghost
                 .settings(b.points_per_cell.max(1) as usize, false, None),
+            dimension: b.dimension as usize,
             ..CantileverSpec::default()
         }
     }

@@ -40,7 +40,7 @@ pub struct CantileverRecord {
     pub load_steps: usize,
     pub status: CaseStatus,
     pub failure: Option<FailureRecord>,
-    /// End displacement (mean of the two loaded points) after each converged step.
+    /// End displacement (mean of the loaded points; FEM: the loaded node) after each converged step.
     pub end: Vec<EndDisplacement>,
     /// Final u/L and v/L (converged cases only).
     pub u_over_l: Option<f64>,
@@ -53,8 +53,8 @@ pub struct CantileverRecord {
     /// Initial domain half-length and the smallest half-length after each converged step.
     pub initial_half_length: f64,
     pub min_half_length: Vec<f64>,
-    /// Indices of the two loaded points in the domain snapshots.
-    pub loaded_points: Option<[usize; 2]>,
+    /// Indices of the loaded points in the domain snapshots (3D: those in the snapshot's layer).
+    pub loaded_points: Option<Vec<usize>>,
     pub newton_iterations: usize,
     pub steps: Vec<StepRecord>,
 }

@@ -5,7 +5,7 @@
 use super::records::{CompactionRecord, CompactionResults, ReferenceRecord};
 use crate::method::Method;
 use crate::study::checks::{check_at_most, relative_spread, richardson, CheckRecord, GciRecord};
-use crate::study::vocabulary::number;
+use crate::study::vocabulary::{number, points_grid};
 use std::collections::BTreeSet;
 
 pub(super) fn figure17_reference(results: &CompactionResults) -> Option<ReferenceRecord> {
@@ -61,10 +61,12 @@ pub(super) fn figure17_reference(results: &CompactionResults) -> Option<Referenc
         cases: vec![finest.id.clone()],
         observed_order: None,
         description: format!(
-            "finest iGIMP case (h = {}, {}×{} points per cell): the study has no converged FEM reference sweep",
+            "finest iGIMP case (h = {}, {} points per cell): the study has no converged FEM reference sweep",
             finest.h,
-            finest.points_per_cell.unwrap_or(0),
-            finest.points_per_cell.unwrap_or(0)
+            points_grid(
+                finest.points_per_cell.unwrap_or(0),
+                results.study.block.dimension as usize
+            )
         ),
     })
 }
@@ -235,7 +237,11 @@ pub(super) fn gci_records(results: &CompactionResults) -> Vec<GciRecord> {
                 .filter_map(|c| Some((c.h, c.max_horizontal_displacement?)))
                 .collect();
             let label = match ppc {
-                Some(p) => format!("{}, {p}×{p} points", m.label()),
+                Some(p) => format!(
+                    "{}, {} points",
+                    m.label(),
+                    points_grid(p, results.study.block.dimension as usize)
+                ),
                 None => m.label().to_string(),
             };
             out.push(GciRecord::of(
