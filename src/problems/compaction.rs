@@ -211,6 +211,19 @@ pub struct DomainRecord {
     pub plastic_multiplier: f64,
 }
 
+/// Final state of one material point of a 3D analysis (ParaView output).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Domain3dRecord {
+    pub x0: [f64; 3],
+    pub x: [f64; 3],
+    /// Initial and current domain half-lengths.
+    pub half0: [f64; 3],
+    pub half: [f64; 3],
+    /// Cauchy stress σ_zz (vertical).
+    pub sigma_zz: f64,
+    pub plastic_multiplier: f64,
+}
+
 /// Outcome of one compaction analysis.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompactionOutcome {
@@ -225,6 +238,8 @@ pub struct CompactionOutcome {
     pub num_points: usize,
     /// Final domains: every point in 2D, the slice next to y = 0 in 3D ([`solve_mpm_3d`]).
     pub points: Vec<DomainRecord>,
+    /// Every point's final 3D domain (empty in 2D).
+    pub points_3d: Vec<Domain3dRecord>,
 }
 
 /// Run the compaction problem with material points.
@@ -260,6 +275,7 @@ pub fn solve_mpm(spec: &CompactionSpec) -> Result<CompactionOutcome, InputError>
         failure,
         max_horizontal_displacement,
         points,
+        points_3d: vec![],
     })
 }
 
@@ -342,6 +358,8 @@ pub struct CompactionSolution {
     /// Final material point domains (none for FEM); in 3D the slice next to the symmetry
     /// plane y = 0 ([`solve_mpm_3d`]).
     pub domains: Vec<DomainRecord>,
+    /// Every point's final 3D domain (3D material points only).
+    pub domains_3d: Vec<Domain3dRecord>,
 }
 
 /// Solve the compaction by `method`: iGIMP or MPM weights on the material points (the
@@ -367,6 +385,7 @@ pub fn solve(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution
                 weak_nodes_treated: 0,
                 size: o.elements,
                 domains: vec![],
+                domains_3d: vec![],
             });
         }
         _ => return Err(unsupported(spec, method)),
@@ -379,6 +398,7 @@ pub fn solve(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution
         max_horizontal_displacement: o.max_horizontal_displacement,
         weak_nodes_treated: o.weak_nodes_treated,
         domains: o.points,
+        domains_3d: o.points_3d,
     })
 }
 
@@ -466,6 +486,17 @@ pub fn solve_mpm_3d(spec: &CompactionSpec) -> Result<CompactionOutcome, InputErr
             plastic_multiplier: pts.state[p].material.plastic_multiplier,
         })
         .collect();
+    let arr = |v: &SVector<f64, 3>| [v[0], v[1], v[2]];
+    let points_3d = (0..pts.len())
+        .map(|p| Domain3dRecord {
+            x0: arr(&pts.position0[p]),
+            x: arr(&pts.position[p]),
+            half0: arr(&pts.half_length0[p]),
+            half: arr(&pts.half_length[p]),
+            sigma_zz: pts.state[p].cauchy()[(2, 2)],
+            plastic_multiplier: pts.state[p].material.plastic_multiplier,
+        })
+        .collect();
     Ok(CompactionOutcome {
         num_points: pts.len(),
         weak_nodes_treated: steps.iter().map(|s| s.weak_nodes).sum(),
@@ -473,6 +504,7 @@ pub fn solve_mpm_3d(spec: &CompactionSpec) -> Result<CompactionOutcome, InputErr
         failure,
         max_horizontal_displacement,
         points,
+        points_3d,
     })
 }
 
@@ -535,6 +567,7 @@ fn solve_3d(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution,
                 max_horizontal_displacement: o.max_horizontal_displacement,
                 weak_nodes_treated: o.weak_nodes_treated,
                 domains: o.points,
+                domains_3d: o.points_3d,
             });
         }
         Method::FemHex8 => HexElement::Hex8,
@@ -549,5 +582,6 @@ fn solve_3d(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution,
         weak_nodes_treated: 0,
         size: o.elements,
         domains: vec![],
+        domains_3d: vec![],
     })
 }

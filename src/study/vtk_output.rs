@@ -151,33 +151,69 @@ impl ColumnVtkWriter {
     }
 }
 
-/// One frame of a plane-strain case for ParaView: material point domains (centre and
-/// half-lengths) at `time` (the load factor), with per-point scalars.
+/// A material point domain: its centre and half-lengths (z zero in 2D).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DomainBox {
+    pub centre: [f64; 3],
+    pub half: [f64; 3],
+}
+
+impl From<[f64; 4]> for DomainBox {
+    /// A plane domain from (x, y, half-length x, half-length y).
+    fn from(d: [f64; 4]) -> Self {
+        DomainBox {
+            centre: [d[0], d[1], 0.0],
+            half: [d[2], d[3], 0.0],
+        }
+    }
+}
+
+/// One frame of a case for ParaView: material point domains at `time` (the load factor),
+/// with per-point scalars; quadrilaterals in 2D, hexahedra in 3D.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DomainFrame {
     pub time: f64,
     pub step: usize,
-    /// (x, y, half-length x, half-length y) per point.
-    pub domains: Vec<[f64; 4]>,
+    /// 2 or 3.
+    pub dimension: usize,
+    pub domains: Vec<DomainBox>,
     pub scalars: Vec<(String, Vec<f64>)>,
 }
 
-/// The domains of a frame as quadrilaterals (cell `p` is point `p`'s domain, its scalars as
-/// cell data), so that ParaView draws the GIMP domains as the paper's figures do.
+/// The domains of a frame as quadrilaterals (2D) or hexahedra (3D, VTK node order): cell `p`
+/// is point `p`'s domain, its scalars as cell data, so that ParaView draws the GIMP domains
+/// as the paper's figures do.
 pub fn domains_grid(frame: &DomainFrame) -> UnstructuredGrid {
-    let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
-    let mut pts = Vec::with_capacity(4 * frame.domains.len());
+    const CORNERS: [[f64; 3]; 8] = [
+        [-1.0, -1.0, -1.0],
+        [1.0, -1.0, -1.0],
+        [1.0, 1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+        [1.0, -1.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [-1.0, 1.0, 1.0],
+    ];
+    let (k, kind) = if frame.dimension == 3 {
+        (8, vtk::cell::HEXAHEDRON)
+    } else {
+        (4, vtk::cell::QUAD)
+    };
+    let mut pts = Vec::with_capacity(k * frame.domains.len());
     for d in &frame.domains {
-        for (sx, sy) in corners {
-            pts.push([d[0] + sx * d[2], d[1] + sy * d[3], 0.0]);
+        for c in &CORNERS[..k] {
+            pts.push(std::array::from_fn(|a| d.centre[a] + c[a] * d.half[a]));
         }
     }
     let mut g = UnstructuredGrid {
         points: pts,
         ..UnstructuredGrid::default()
     };
+    let mut nodes = Vec::with_capacity(k);
     for p in 0..frame.domains.len() {
-        g.push_cell(vtk::cell::QUAD, &[4 * p, 4 * p + 1, 4 * p + 2, 4 * p + 3]);
+        nodes.clear();
+        nodes.extend(k * p..k * (p + 1));
+        g.push_cell(kind, &nodes);
     }
     let cell = |name: &str, components: usize, values: Vec<f64>| vtk::DataArray {
         name: name.to_string(),
@@ -187,12 +223,12 @@ pub fn domains_grid(frame: &DomainFrame) -> UnstructuredGrid {
     g.cell_data.push(cell(
         "centre",
         3,
-        frame.domains.iter().flat_map(|d| [d[0], d[1], 0.0]).collect(),
+        frame.domains.iter().flat_map(|d| d.centre).collect(),
     ));
     g.cell_data.push(cell(
         "half_length",
         3,
-        frame.domains.iter().flat_map(|d| [d[2], d[3], 0.0]).collect(),
+        frame.domains.iter().flat_map(|d| d.half).collect(),
     ));
     for (name, values) in &frame.scalars {
         g.cell_data.push(cell(name, 1, values.clone()));

@@ -532,3 +532,76 @@ fn sharded_runs_merge_to_the_unsharded_results() {
     let b = read_results::<compaction::CompactionResults>(&tmp.path().join("whole/compaction")).unwrap();
     assert_eq!(a.without_timing(), b.without_timing());
 }
+
+/// 3D domains go to ParaView as hexahedra (VTK order): meshio reads one `hexahedron` per
+/// point whose 8 corners are centre ± half-lengths, with the cell data in point order.
+#[test]
+fn vtk_3d_domains_are_hexahedra_read_by_meshio() {
+    use igimp::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
+    let tmp = tempfile::tempdir().unwrap();
+    let domains = vec![
+        DomainBox {
+            centre: [0.25, 0.25, 0.25],
+            half: [0.25, 0.25, 0.25],
+        },
+        DomainBox {
+            centre: [1.0, 2.0, 3.0],
+            half: [0.1, 0.2, 0.3],
+        },
+    ];
+    let frame = DomainFrame {
+        time: 1.0,
+        step: 3,
+        dimension: 3,
+        domains: domains.clone(),
+        scalars: vec![("sigma_zz".into(), vec![-1.0, -2.0])],
+    };
+    let pvd = write_domain_frames(tmp.path(), "case", &[frame]).unwrap();
+    assert!(pvd.is_file());
+    if !meshio_available() {
+        return;
+    }
+    const SCRIPT: &str = r#"
+import json, sys, meshio
+m = meshio.read(sys.argv[1])
+c = m.cells[0]
+print(json.dumps({"type": c.type, "corners": [[m.points[i].tolist() for i in cell] for cell in c.data],
+                  "sigma_zz": m.cell_data["sigma_zz"][0].reshape(-1).tolist()}))
+"#;
+    let out = Command::new("python3")
+        .arg("-c")
+        .arg(SCRIPT)
+        .arg(tmp.path().join("vtk/case/domains_00003.vtu"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let m: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(m["type"], "hexahedron");
+    let corners = m["corners"].as_array().unwrap();
+    assert_eq!(corners.len(), 2);
+    for (d, cell) in domains.iter().zip(corners) {
+        let cell = cell.as_array().unwrap();
+        assert_eq!(cell.len(), 8);
+        for (k, x) in cell.iter().enumerate() {
+            // VTK hexahedron order: bottom face (z−) counter-clockwise, then the top face.
+            let sign = [
+                [-1, -1, -1],
+                [1, -1, -1],
+                [1, 1, -1],
+                [-1, 1, -1],
+                [-1, -1, 1],
+                [1, -1, 1],
+                [1, 1, 1],
+                [-1, 1, 1],
+            ][k];
+            for a in 0..3 {
+                let expect = d.centre[a] + sign[a] as f64 * d.half[a];
+                assert!(
+                    (x[a].as_f64().unwrap() - expect).abs() < 1e-12,
+                    "corner {k} axis {a}"
+                );
+            }
+        }
+    }
+    assert_eq!(m["sigma_zz"], serde_json::json!([-1.0, -2.0]));
+}

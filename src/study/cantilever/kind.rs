@@ -166,7 +166,8 @@ fn write_case_vtk(
         .map(|s| DomainFrame {
             time: s.step as f64 / case.spec.load_steps.max(1) as f64,
             step: s.step,
-            domains: s.domains.clone(),
+            dimension: 2,
+            domains: s.domains.iter().map(|&d| d.into()).collect(),
             scalars: vec![],
         })
         .collect();

@@ -5,15 +5,17 @@
 use super::records::{CompactionMeasures, CompactionRecord};
 use super::{CompactionCase, CompactionFigureKind, CompactionStudy};
 use crate::method::Method;
-use crate::problems::compaction::{solve, DomainRecord};
+use crate::problems::compaction::{solve, Domain3dRecord, DomainRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};
-use crate::study::vtk_output::{write_domain_frames, DomainFrame};
+use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
 use crate::study::{StudyError, Tier};
 use std::collections::BTreeSet;
 use std::path::Path;
 
-fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
+/// One case: its record, the domains the figures draw, and (3D) every point's domain for
+/// ParaView, which the kind does not keep.
+fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>, Vec<Domain3dRecord>) {
     let s = &case.spec;
     let (solved, o) = match solve(s, case.method) {
         Err(e) => (SolveRecord::rejected(e), None),
@@ -45,7 +47,8 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>) {
         newton_iterations: solved.newton_iterations,
         steps: solved.steps,
     };
-    (rec, o.map_or(vec![], |o| o.domains))
+    let (domains, domains_3d) = o.map_or((vec![], vec![]), |o| (o.domains, o.domains_3d));
+    (rec, domains, domains_3d)
 }
 
 impl StudyKind for CompactionStudy {
@@ -60,10 +63,7 @@ impl StudyKind for CompactionStudy {
         self.cases(tier)
     }
     fn key(&self, c: &CompactionCase) -> CaseKey {
-        let mut key = CaseKey::of_spec(&c.id, c.method, &c.spec, 0);
-        // The ParaView writer draws 2D domains; 3D cases have no VTK output yet.
-        key.has_vtk &= c.spec.dimension == 2;
-        key
+        CaseKey::of_spec(&c.id, c.method, &c.spec, 0)
     }
     fn cost(&self, c: &CompactionCase) -> f64 {
         let s = &c.spec;
@@ -71,11 +71,11 @@ impl StudyKind for CompactionStudy {
         (s.points_per_cell as f64 / s.element_size).powi(d)
     }
     fn solve(&self, c: &CompactionCase, vtk: Option<&VtkTarget>) -> Result<Self::Output, StudyError> {
-        let out = solve_case(c);
+        let (rec, domains, domains_3d) = solve_case(c);
         if let Some(v) = vtk {
-            write_case_vtk(&v.study_dir, c, &out)?;
+            write_case_vtk(&v.study_dir, c, &rec, &domains, &domains_3d)?;
         }
-        Ok(out)
+        Ok((rec, domains))
     }
     fn record(o: &Self::Output) -> &CompactionRecord {
         &o.0
@@ -113,38 +113,68 @@ impl CompactionStudy {
     }
 }
 
-/// ParaView files of an iGIMP case: the initial domains and those of the last converged step
-/// (σyy and the plastic multiplier as cell data).
+/// ParaView files of an iGIMP or MPM case: the initial domains and those of the last
+/// converged step (the vertical stress and the plastic multiplier as cell data):
+/// quadrilaterals in 2D, every point's hexahedron in 3D (`domains_3d`).
 fn write_case_vtk(
     dir: &Path,
     case: &CompactionCase,
-    out: &(CompactionRecord, Vec<DomainRecord>),
+    rec: &CompactionRecord,
+    doms: &[DomainRecord],
+    doms_3d: &[Domain3dRecord],
 ) -> Result<(), StudyError> {
-    let (rec, doms) = out;
-    let initial = DomainFrame {
-        time: 0.0,
-        step: 0,
-        domains: doms
-            .iter()
-            .map(|d| [d.x0[0], d.x0[1], d.half0[0], d.half0[1]])
-            .collect(),
-        scalars: vec![],
-    };
     let steps = rec.steps.len();
-    let last = DomainFrame {
-        time: steps as f64 / case.spec.load_steps.max(1) as f64,
-        step: steps,
-        domains: doms
-            .iter()
-            .map(|d| [d.x[0], d.x[1], d.half[0], d.half[1]])
-            .collect(),
-        scalars: vec![
-            ("sigma_yy".into(), doms.iter().map(|d| d.sigma_yy).collect()),
-            (
-                "plastic_multiplier".into(),
-                doms.iter().map(|d| d.plastic_multiplier).collect(),
-            ),
-        ],
+    let frame = |step: usize, domains: Vec<DomainBox>, scalars| DomainFrame {
+        time: step as f64 / case.spec.load_steps.max(1) as f64,
+        step,
+        dimension: case.spec.dimension,
+        domains,
+        scalars,
     };
-    write_domain_frames(dir, &case.id, &[initial, last]).map(|_| ())
+    let (initial, last, stress, plastic): (Vec<DomainBox>, Vec<DomainBox>, Vec<f64>, Vec<f64>) =
+        if case.spec.dimension == 3 {
+            (
+                doms_3d
+                    .iter()
+                    .map(|d| DomainBox {
+                        centre: d.x0,
+                        half: d.half0,
+                    })
+                    .collect(),
+                doms_3d
+                    .iter()
+                    .map(|d| DomainBox {
+                        centre: d.x,
+                        half: d.half,
+                    })
+                    .collect(),
+                doms_3d.iter().map(|d| d.sigma_zz).collect(),
+                doms_3d.iter().map(|d| d.plastic_multiplier).collect(),
+            )
+        } else {
+            (
+                doms.iter()
+                    .map(|d| [d.x0[0], d.x0[1], d.half0[0], d.half0[1]].into())
+                    .collect(),
+                doms.iter()
+                    .map(|d| [d.x[0], d.x[1], d.half[0], d.half[1]].into())
+                    .collect(),
+                doms.iter().map(|d| d.sigma_yy).collect(),
+                doms.iter().map(|d| d.plastic_multiplier).collect(),
+            )
+        };
+    let vertical = if case.spec.dimension == 3 {
+        "sigma_zz"
+    } else {
+        "sigma_yy"
+    };
+    let frames = [
+        frame(0, initial, vec![]),
+        frame(
+            steps,
+            last,
+            vec![(vertical.into(), stress), ("plastic_multiplier".into(), plastic)],
+        ),
+    ];
+    write_domain_frames(dir, &case.id, &frames).map(|_| ())
 }

@@ -92,10 +92,11 @@ impl StudyKind for ManufacturedStudy {
             let frame = DomainFrame {
                 time: 1.0,
                 step: out.0.steps.len(),
+                dimension: 2,
                 domains: p
                     .points
                     .iter()
-                    .map(|q| [q.x[0], q.x[1], q.half[0], q.half[1]])
+                    .map(|q| [q.x[0], q.x[1], q.half[0], q.half[1]].into())
                     .collect(),
                 scalars: vec![("stress_error".into(), p.stress_error.clone())],
             };
