@@ -79,6 +79,7 @@ fn range_of(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
 pub fn domains_svg(
     title: &str,
     colour_label: &str,
+    axes: (&str, &str),
     layers: &[DomainLayer],
     marks: &[PointMarks],
 ) -> PlotResult<String> {
@@ -117,8 +118,8 @@ pub fn domains_svg(
             .map_err(err)?;
         chart
             .configure_mesh()
-            .x_desc("x")
-            .y_desc("y")
+            .x_desc(axes.0)
+            .y_desc(axes.1)
             .axis_desc_style((FONT, AXIS_DESC_PT))
             .label_style((FONT, TICK_PT))
             .x_label_formatter(&|v| format!("{v:.1}"))

@@ -216,7 +216,9 @@ fn render_figure(
                 (Some(fl), CaseStatus::Failed) => format!("{} (failed at step {})", f.title, fl.step),
                 _ => f.title.clone(),
             };
-            domains_svg(&title, "", &layers, &marks).map(Some).map_err(fail)
+            domains_svg(&title, "", ("x", "y"), &layers, &marks)
+                .map(Some)
+                .map_err(fail)
         }
         CantileverFigureKind::EndDisplacement => {
             let mut series = vec![];

@@ -279,14 +279,15 @@ fn render_figure(
                 _ => format!("{} (last converged step)", f.title),
             };
             // The 3D study's domains are the slice next to y = 0, vertical axis z.
-            let vertical = if results.study.block.dimension == 3 {
-                "σzz"
+            let (vertical, axis) = if results.study.block.dimension == 3 {
+                ("σzz", "z")
             } else {
-                "σyy"
+                ("σyy", "y")
             };
             domains_svg(
                 &title,
                 vertical,
+                ("x", axis),
                 &[
                     DomainLayer {
                         label: "initial".into(),

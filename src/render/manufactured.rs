@@ -196,7 +196,7 @@ fn render_figure(
                 values: Some(p.stress_error.clone()),
                 colour: None,
             };
-            domains_svg(&f.title, "‖σ_p − σ(X_p)‖ / σ_max", &[layer], &[])
+            domains_svg(&f.title, "‖σ_p − σ(X_p)‖ / σ_max", ("x", "y"), &[layer], &[])
                 .map(Some)
                 .map_err(err)
         }
