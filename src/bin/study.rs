@@ -51,8 +51,8 @@ struct Cli {
     /// Write ParaView files `<out>/<name>/vtk/<case>.pvd` of the initial and the final state:
     /// column, the material/Gauss points and the grid/mesh (1D only: column-3d writes none
     /// yet); compaction, cantilever and manufactured, the material point domains
-    /// (quadrilaterals; hexahedra in compaction-3d, cantilever-3d writes none yet) of the
-    /// iGIMP and MPM cases (FEM cases write none).
+    /// (quadrilaterals in 2D, hexahedra in compaction-3d and cantilever-3d) of the iGIMP and
+    /// MPM cases (FEM cases write none).
     #[arg(long)]
     vtk: bool,
     /// With --vtk, also write every N-th load step (implies --vtk; column and cantilever;

@@ -314,6 +314,35 @@ pub struct CantileverOutcome {
     pub min_half_length: Vec<f64>,
     /// The loaded points, as indices into the snapshots' domains.
     pub loaded_points: Vec<usize>,
+    /// 3D only: every point's domain at the snapshot steps, for ParaView.
+    pub solid_snapshots: Vec<SolidSnapshot>,
+}
+
+/// Every material point's domain at one instant of a 3D analysis: (x, y, z, half-lengths
+/// x, y, z) per point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolidSnapshot {
+    pub step: usize,
+    pub domains: Vec<[f64; 6]>,
+}
+
+fn solid_snapshot<const D: usize>(solver: &MpmSolver<D>, step: usize) -> SolidSnapshot {
+    let p = &solver.points;
+    let pad = |v: &SVector<f64, D>, a: usize| if a < D { v[a] } else { 0.0 };
+    SolidSnapshot {
+        step,
+        domains: (0..p.len())
+            .map(|i| {
+                std::array::from_fn(|k| {
+                    if k < 3 {
+                        pad(&p.position[i], k)
+                    } else {
+                        pad(&p.half_length[i], k - 3)
+                    }
+                })
+            })
+            .collect(),
+    }
 }
 
 fn snapshot<const D: usize>(solver: &MpmSolver<D>, shown: &[usize], step: usize) -> DomainSnapshot {
@@ -363,10 +392,13 @@ fn run_mpm<const D: usize>(
     shown: Vec<usize>,
     snapshot_every: usize,
 ) -> Result<CantileverOutcome, InputError> {
+    // 3D runs also keep every point's domain, for ParaView (the snapshots hold a layer).
+    let solid = |solver: &MpmSolver<D>, step: usize| (D == 3).then(|| solid_snapshot(solver, step));
     let mut out = CantileverOutcome {
         steps: vec![],
         end: vec![],
         failure: None,
+        solid_snapshots: solid(&solver, 0).into_iter().collect(),
         snapshots: vec![snapshot(&solver, &shown, 0)],
         min_half_length: vec![],
         loaded_points: shown
@@ -400,11 +432,13 @@ fn run_mpm<const D: usize>(
                 );
                 if snapshot_every > 0 && (r.step % snapshot_every == 0 || r.step == solver.load_steps()) {
                     out.snapshots.push(snapshot(&solver, &shown, r.step));
+                    out.solid_snapshots.extend(solid(&solver, r.step));
                 }
                 out.steps.push(r);
             }
             Err(e) => {
                 out.snapshots.push(snapshot(&solver, &shown, solver.steps_done()));
+                out.solid_snapshots.extend(solid(&solver, solver.steps_done()));
                 out.failure = Some(e);
                 break;
             }
@@ -580,6 +614,8 @@ pub struct CantileverSolution {
     pub snapshots: Vec<DomainSnapshot>,
     pub min_half_length: Vec<f64>,
     pub loaded_points: Option<Vec<usize>>,
+    /// 3D iGIMP only: every point's domain at the snapshot steps ([`SolidSnapshot`]).
+    pub solid_snapshots: Vec<SolidSnapshot>,
 }
 
 /// Solve the cantilever by `method`: iGIMP ([`solve_mpm`], snapshots every
@@ -597,6 +633,7 @@ pub fn solve(
         snapshots: vec![],
         min_half_length: vec![],
         loaded_points: None,
+        solid_snapshots: vec![],
     };
     match (method, spec.dimension) {
         (Method::Igimp, _) => solve_mpm(spec, snapshot_every).map(|o| CantileverSolution {
@@ -606,6 +643,7 @@ pub fn solve(
             snapshots: o.snapshots,
             min_half_length: o.min_half_length,
             loaded_points: Some(o.loaded_points),
+            solid_snapshots: o.solid_snapshots,
         }),
         (Method::FemQ8, 2) => solve_fem_q8(spec).map(fem),
         (Method::FemHex8, 3) => solve_fem_3d(spec, HexElement::Hex8).map(fem),

@@ -6,11 +6,11 @@
 use super::records::{CantileverMeasures, CantileverRecord, ElasticaPath, ElasticaPoint};
 use super::{CantileverCase, CantileverStudy};
 use crate::method::Method;
-use crate::problems::cantilever::{solve, CantileverSpec, DomainSnapshot};
+use crate::problems::cantilever::{solve, CantileverSpec, DomainSnapshot, SolidSnapshot};
 use crate::problems::elastica::{bending_stiffness, Elastica};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};
-use crate::study::vtk_output::{write_domain_frames, DomainFrame};
+use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
 use crate::study::{StudyError, Tier};
 use std::path::Path;
 
@@ -44,7 +44,7 @@ pub(super) fn elastica_path(spec: &CantileverSpec, plane_strain: bool) -> Option
 fn solve_case_snapshots(
     case: &CantileverCase,
     snapshot_every: usize,
-) -> (CantileverRecord, Vec<DomainSnapshot>) {
+) -> (CantileverRecord, Vec<DomainSnapshot>, Vec<SolidSnapshot>) {
     let s = &case.spec;
     let igimp = case.method == Method::Igimp;
     let (solved, o) = match solve(s, case.method, snapshot_every) {
@@ -52,9 +52,15 @@ fn solve_case_snapshots(
         Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
     };
     let elastica = elastica_path(s, s.dimension == 2).and_then(|p| p.points.last().copied());
-    let (end, min_half_length, loaded_points, mut snaps) = match o {
-        Some(o) => (o.end, o.min_half_length, o.loaded_points, o.snapshots),
-        None => (vec![], vec![], None, vec![]),
+    let (end, min_half_length, loaded_points, mut snaps, mut solid) = match o {
+        Some(o) => (
+            o.end,
+            o.min_half_length,
+            o.loaded_points,
+            o.snapshots,
+            o.solid_snapshots,
+        ),
+        None => (vec![], vec![], None, vec![], vec![]),
     };
     let last = end.last().filter(|_| solved.status == CaseStatus::Converged);
     let (u, v) = (last.map(|e| e.u_over_l), last.map(|e| e.v_over_l));
@@ -84,7 +90,8 @@ fn solve_case_snapshots(
     };
     // Keep one snapshot per step (a failing step repeats the last converged state).
     snaps.dedup_by_key(|s| s.step);
-    (rec, snaps)
+    solid.dedup_by_key(|s| s.step);
+    (rec, snaps, solid)
 }
 
 impl StudyKind for CantileverStudy {
@@ -99,10 +106,7 @@ impl StudyKind for CantileverStudy {
         (self.cases(tier), SweepIndex::new())
     }
     fn key(&self, c: &CantileverCase) -> CaseKey {
-        let mut key = CaseKey::of_spec(&c.id, c.method, &c.spec, c.snapshot_every);
-        // The ParaView writer draws 2D domains; 3D cases have no VTK output yet.
-        key.has_vtk &= c.spec.dimension == 2;
-        key
+        CaseKey::of_spec(&c.id, c.method, &c.spec, c.snapshot_every)
     }
     fn cost(&self, c: &CantileverCase) -> f64 {
         let d = c.spec.dimension as i32;
@@ -121,11 +125,11 @@ impl StudyKind for CantileverStudy {
             }
             _ => c.snapshot_every,
         };
-        let out = solve_case_snapshots(c, every);
+        let (rec, snaps, solid) = solve_case_snapshots(c, every);
         if let Some(v) = vtk {
-            write_case_vtk(&v.study_dir, c, &out)?;
+            write_case_vtk(&v.study_dir, c, &snaps, &solid)?;
         }
-        Ok(out)
+        Ok((rec, snaps))
     }
     fn record(o: &Self::Output) -> &CantileverRecord {
         &o.0
@@ -154,22 +158,44 @@ impl StudyKind for CantileverStudy {
 }
 
 /// ParaView files of an iGIMP case: its domain snapshots (the initial state, every
-/// `--vtk-every` steps or the figure's interval, and the last converged step).
+/// `--vtk-every` steps or the figure's interval, and the last converged step);
+/// quadrilaterals in 2D, every point's hexahedron in 3D.
 fn write_case_vtk(
     dir: &Path,
     case: &CantileverCase,
-    out: &(CantileverRecord, Vec<DomainSnapshot>),
+    snaps: &[DomainSnapshot],
+    solid: &[SolidSnapshot],
 ) -> Result<(), StudyError> {
-    let frames: Vec<DomainFrame> = out
-        .1
-        .iter()
-        .map(|s| DomainFrame {
-            time: s.step as f64 / case.spec.load_steps.max(1) as f64,
-            step: s.step,
-            dimension: 2,
-            domains: s.domains.iter().map(|&d| d.into()).collect(),
-            scalars: vec![],
-        })
-        .collect();
+    let time = |step: usize| step as f64 / case.spec.load_steps.max(1) as f64;
+    let frames: Vec<DomainFrame> = if case.spec.dimension == 3 {
+        solid
+            .iter()
+            .map(|s| DomainFrame {
+                time: time(s.step),
+                step: s.step,
+                dimension: 3,
+                domains: s
+                    .domains
+                    .iter()
+                    .map(|d| DomainBox {
+                        centre: [d[0], d[1], d[2]],
+                        half: [d[3], d[4], d[5]],
+                    })
+                    .collect(),
+                scalars: vec![],
+            })
+            .collect()
+    } else {
+        snaps
+            .iter()
+            .map(|s| DomainFrame {
+                time: time(s.step),
+                step: s.step,
+                dimension: 2,
+                domains: s.domains.iter().map(|&d| d.into()).collect(),
+                scalars: vec![],
+            })
+            .collect()
+    };
     write_domain_frames(dir, &case.id, &frames).map(|_| ())
 }
