@@ -2,9 +2,12 @@
 //! §5.3 Figure 21).
 //!
 //! The entry points are [`LineFem`], a 1D solver on a [`LineMesh`] of linear or quadratic
-//! elements with a Gauss rule of 1 to 5 points, and [`PlaneFem`], a plane-strain solver on a
-//! [`PlaneMesh`] of 4-node or 8-node serendipity quadrilaterals ([`QuadElement`]) with an n×n
-//! Gauss rule (default 2×2 for Q4, 3×3 for Q8). Both implement
+//! elements with a Gauss rule of 1 to 5 points, and [`ContinuumFem`] on an [`ElementMesh`] of
+//! one tensor-product family: [`PlaneFem`], plane strain on 4-node or 8-node serendipity
+//! quadrilaterals ([`QuadElement`], [`PlaneMesh`]) with an n×n Gauss rule (default 2×2 for
+//! Q4, 3×3 for Q8), and [`SolidFem`], 3D on 8-node or 20-node serendipity hexahedra
+//! ([`HexElement`], [`HexMesh`]) with an n×n×n rule (default 2×2×2 for Hex8, 3×3×3 for
+//! Hex20); one shape-function formula serves all four ([`serendipity_shape`]). Both implement
 //! [`LoadStepping`] through the same generic load step
 //! (`fem_step` over the [`FemMesh`] trait: a mesh supplies its shape functions and moves its
 //! nodes; Gauss point storage is [`GaussPoints`]). Each shares everything below the load-step loop
