@@ -208,6 +208,18 @@ fn atanh_sqrt_over_sqrt<T: DualNum<Primitive = f64> + Copy>(s: T) -> T {
 /// mean and g the half-gap of the eigenvalues) and α = ½ ln det b − β m: the same as the
 /// spectral form, smooth where the eigenvalues coincide (F = I), so it differentiates there.
 pub fn kirchhoff<T: DualNum<Primitive = f64> + Copy>(f: &M2<T>, lambda: f64, mu: f64) -> (M2<T>, T) {
+    kirchhoff_block(f, T::one(), lambda, mu)
+}
+
+/// Kirchhoff stress of Hencky elasticity for F = diag(F₂, f₃₃) (an in-plane block and a
+/// stretch along z): the in-plane block of τ and τ_zz. Plane strain is f₃₃ = 1
+/// ([`kirchhoff`]); the 3D manufactured fields ([`super::manufactured3d`]) have this form.
+pub fn kirchhoff_block<T: DualNum<Primitive = f64> + Copy>(
+    f: &M2<T>,
+    f33: T,
+    lambda: f64,
+    mu: f64,
+) -> (M2<T>, T) {
     let b00 = f[0][0] * f[0][0] + f[0][1] * f[0][1];
     let b01 = f[0][0] * f[1][0] + f[0][1] * f[1][1];
     let b11 = f[1][0] * f[1][0] + f[1][1] * f[1][1];
@@ -221,19 +233,30 @@ pub fn kirchhoff<T: DualNum<Primitive = f64> + Copy>(f: &M2<T>, lambda: f64, mu:
     let e00 = (alpha + beta * b00) * 0.5;
     let e11 = (alpha + beta * b11) * 0.5;
     let e01 = beta * b01 * 0.5;
-    let tr = (e00 + e11) * lambda;
+    let e33 = f33.ln();
+    let tr = (e00 + e11 + e33) * lambda;
     (
         [
             [tr + e00 * (2.0 * mu), e01 * (2.0 * mu)],
             [e01 * (2.0 * mu), tr + e11 * (2.0 * mu)],
         ],
-        tr,
+        tr + e33 * (2.0 * mu),
     )
 }
 
 /// First Piola–Kirchhoff stress P = τ F⁻ᵀ (in-plane).
 pub fn first_piola<T: DualNum<Primitive = f64> + Copy>(f: &M2<T>, lambda: f64, mu: f64) -> M2<T> {
-    let (tau, _) = kirchhoff(f, lambda, mu);
+    first_piola_block(f, T::one(), lambda, mu).0
+}
+
+/// P = τ F⁻ᵀ for F = diag(F₂, f₃₃): the in-plane block and P_zz = τ_zz / f₃₃.
+pub fn first_piola_block<T: DualNum<Primitive = f64> + Copy>(
+    f: &M2<T>,
+    f33: T,
+    lambda: f64,
+    mu: f64,
+) -> (M2<T>, T) {
+    let (tau, tzz) = kirchhoff_block(f, f33, lambda, mu);
     let j = f[0][0] * f[1][1] - f[0][1] * f[1][0];
     // F⁻¹ = adj(F) / J; P_iJ = Σ_K τ_iK (F⁻¹)_JK.
     let inv = [[f[1][1] / j, -f[0][1] / j], [-f[1][0] / j, f[0][0] / j]];
@@ -243,7 +266,7 @@ pub fn first_piola<T: DualNum<Primitive = f64> + Copy>(f: &M2<T>, lambda: f64, m
             p[i][jj] = tau[i][0] * inv[jj][0] + tau[i][1] * inv[jj][1];
         }
     }
-    p
+    (p, tzz / f33)
 }
 
 /// The exact solution of one spec: motion, stresses and body force at a reference point.
@@ -403,10 +426,11 @@ fn sigma4(s: &Matrix3<f64>) -> [f64; 4] {
     [s[(0, 0)], s[(1, 1)], s[(0, 1)], s[(2, 2)]]
 }
 
-/// Rollers on every edge of the unit square: (node, axis) for the nodes `on(axis, value)`.
-fn rollers(on: impl Fn(usize, f64) -> Vec<usize>) -> Vec<(usize, usize)> {
+/// Rollers on every face of the unit square (`axes` = 2) or cube (3): (node, axis) for the
+/// nodes `on(axis, value)`.
+pub(crate) fn rollers(axes: usize, on: impl Fn(usize, f64) -> Vec<usize>) -> Vec<(usize, usize)> {
     let mut fixed = vec![];
-    for axis in 0..2 {
+    for axis in 0..axes {
         for value in [0.0, 1.0] {
             fixed.extend(on(axis, value).into_iter().map(|n| (n, axis)));
         }
@@ -435,6 +459,26 @@ pub fn solve(spec: &ManufacturedSpec, method: Method) -> Result<ManufacturedSolu
 
 type Run = (Vec<StepReport>, Option<SolveError>, Vec<PointValue>);
 
+/// The material point settings of a manufactured case (2D or 3D): iGIMP or MPM weights, no
+/// treatment of nearly empty cells (the grid is the material: no cell is partly filled).
+pub(crate) fn mpm_settings(spec: &ManufacturedSpec, method: Method) -> MpmSettings {
+    MpmSettings {
+        basis: if method == Method::Igimp {
+            Basis::Gimp
+        } else {
+            Basis::Mpm
+        },
+        domain_update: spec.domain_update,
+        newton: spec.newton,
+        load_steps: spec.load_steps,
+        weak_node_tolerance: 0.0,
+        weak_node_treatment: Default::default(),
+        volume_update: Default::default(),
+        linear_solver: LinearSolver::Lu,
+        ghost: Default::default(),
+    }
+}
+
 /// The iGIMP (`igimp`) or MPM (`mpm`) solver of `spec`: points filling the unit square
 /// grid, rollers on every edge, the dead load on the points, undeformed.
 pub fn mpm_solver(spec: &ManufacturedSpec, method: Method) -> Result<MpmSolver<2>, InputError> {
@@ -457,22 +501,8 @@ pub fn mpm_solver(spec: &ManufacturedSpec, method: Method) -> Result<MpmSolver<2
             (p, SVector::<f64, 2>::new(b[0], b[1]) * points.volume0[p])
         })
         .collect();
-    let fixed = rollers(|axis, value| grid.nodes_on_plane(axis, value));
-    let settings = MpmSettings {
-        basis: if method == Method::Igimp {
-            Basis::Gimp
-        } else {
-            Basis::Mpm
-        },
-        domain_update: spec.domain_update,
-        newton: spec.newton,
-        load_steps: spec.load_steps,
-        weak_node_tolerance: 0.0,
-        weak_node_treatment: Default::default(),
-        volume_update: Default::default(),
-        linear_solver: LinearSolver::Lu,
-        ghost: Default::default(),
-    };
+    let fixed = rollers(2, |axis, value| grid.nodes_on_plane(axis, value));
+    let settings = mpm_settings(spec, method);
     let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
     let loads = Loads {
         gravity: SVector::zeros(),
@@ -535,7 +565,7 @@ pub fn fem_solver(spec: &ManufacturedSpec, method: Method) -> Result<PlaneFem, I
             }
         }
     }
-    let fixed = rollers(|axis, value| mesh.nodes_at(axis, value, 1e-9 / n as f64));
+    let fixed = rollers(2, |axis, value| mesh.nodes_at(axis, value, 1e-9 / n as f64));
     let loads = PlaneLoads {
         gravity: SVector::zeros(),
         nodal_forces: force.into_iter().enumerate().collect(),

@@ -6,3 +6,4 @@ pub mod column;
 pub mod compaction;
 pub mod elastica;
 pub mod manufactured;
+pub mod manufactured3d;
