@@ -11,7 +11,8 @@ use crate::basis::Basis;
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::fem::{
-    HexElement, HexMesh, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement, SolidFem, SolidLoads,
+    ContinuumFem, ElementFamily, ElementMesh, FemLoads, HexElement, HexMesh, PlaneFemSettings, PlaneMesh,
+    QuadElement,
 };
 use crate::ghost::{GhostFaces, GhostSettings};
 use crate::grid::Grid;
@@ -295,28 +296,47 @@ pub struct FemOutcome {
 /// locks). LDLᵀ solves.
 pub fn solve_fem(spec: &CompactionSpec, element: QuadElement) -> Result<FemOutcome, InputError> {
     let h = spec.element_size;
-    let cells = (
+    let cells = [
         (spec.half_width / h).round() as usize,
         (spec.height / h).round() as usize,
-    );
+    ];
     let size = SVector::<f64, 2>::new(spec.half_width, spec.height);
-    let mesh = PlaneMesh::rectangle(SVector::zeros(), size, cells, element)?;
-    let tol = 1e-9 * h;
-    let mut fixed: Vec<(usize, usize)> = mesh.nodes_at(0, 0.0, tol).into_iter().map(|n| (n, 0)).collect();
-    fixed.extend(mesh.nodes_at(1, 0.0, tol).into_iter().map(|n| (n, 1)));
-    let corner = mesh.nearest_node(SVector::<f64, 2>::new(spec.half_width, 0.0));
+    solve_fem_block(
+        spec,
+        PlaneMesh::structured(SVector::zeros(), size, cells, element)?,
+    )
+}
+
+/// The FEM block of either dimension on `mesh` (the modelled part, from the origin): rollers
+/// on every coordinate plane through the origin (the symmetry planes and the base), gravity
+/// along the last axis, the element's default Gauss rule (2 per axis for Q4/Hex8, 3 for
+/// Q8/Hex20), LDLᵀ. The measure is u_x of the node at (half_width, 0, …).
+fn solve_fem_block<const D: usize, E: ElementFamily<D>>(
+    spec: &CompactionSpec,
+    mesh: ElementMesh<D, E>,
+) -> Result<FemOutcome, InputError> {
+    let tol = 1e-9 * spec.element_size;
+    let mut fixed: Vec<(usize, usize)> = vec![];
+    for axis in 0..D {
+        fixed.extend(mesh.nodes_at(axis, 0.0, tol).into_iter().map(|node| (node, axis)));
+    }
+    let mut corner = SVector::<f64, D>::zeros();
+    corner[0] = spec.half_width;
+    let corner = mesh.nearest_node(corner);
     let elements = mesh.num_elements();
-    let loads = PlaneLoads {
-        gravity: SVector::<f64, 2>::new(0.0, -spec.unit_weight()),
+    let mut gravity = SVector::<f64, D>::zeros();
+    gravity[D - 1] = -spec.unit_weight();
+    let loads = FemLoads {
+        gravity,
         nodal_forces: vec![],
     };
     let settings = PlaneFemSettings {
-        gauss_points: Some(if element == QuadElement::Q4 { 2 } else { 3 }),
+        gauss_points: None,
         newton: spec.newton,
         load_steps: spec.load_steps,
         linear_solver: LinearSolver::Ldlt,
     };
-    let mut fem = PlaneFem::try_new(mesh, 1.0, spec.model()?, fixed, loads, settings)?;
+    let mut fem = ContinuumFem::try_new(mesh, 1.0, spec.model()?, fixed, loads, settings)?;
     let (steps, failure) = match fem.run() {
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
@@ -519,35 +539,10 @@ pub fn solve_fem_3d(spec: &CompactionSpec, element: HexElement) -> Result<FemOut
         (spec.height / h).round() as usize,
     );
     let size = SVector::<f64, 3>::new(spec.half_width, spec.half_width, spec.height);
-    let mesh = HexMesh::cuboid(SVector::zeros(), size, [n, n, nz], element)?;
-    let tol = 1e-9 * h;
-    let mut fixed: Vec<(usize, usize)> = vec![];
-    for axis in 0..3 {
-        fixed.extend(mesh.nodes_at(axis, 0.0, tol).into_iter().map(|node| (node, axis)));
-    }
-    let corner = mesh.nearest_node(SVector::<f64, 3>::new(spec.half_width, 0.0, 0.0));
-    let elements = mesh.num_elements();
-    let loads = SolidLoads {
-        gravity: SVector::<f64, 3>::new(0.0, 0.0, -spec.unit_weight()),
-        nodal_forces: vec![],
-    };
-    let settings = PlaneFemSettings {
-        gauss_points: None,
-        newton: spec.newton,
-        load_steps: spec.load_steps,
-        linear_solver: LinearSolver::Ldlt,
-    };
-    let mut fem = SolidFem::try_new(mesh, 1.0, spec.model()?, fixed, loads, settings)?;
-    let (steps, failure) = match fem.run() {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
-    Ok(FemOutcome {
-        steps,
-        failure,
-        max_horizontal_displacement: fem.displacement(corner)[0],
-        elements,
-    })
+    solve_fem_block(
+        spec,
+        HexMesh::cuboid(SVector::zeros(), size, [n, n, nz], element)?,
+    )
 }
 
 /// The 3D compaction by `method` ([`solve_mpm_3d`], [`solve_fem_3d`]).

@@ -10,6 +10,7 @@
 
 use super::store::confined;
 use super::StudyError;
+use crate::fem::{ElementFamily, HexElement};
 use crate::problems::column::ColumnState;
 use crate::vtk::{self, pad3, PvdEntry, UnstructuredGrid};
 use std::path::{Path, PathBuf};
@@ -184,16 +185,9 @@ pub struct DomainFrame {
 /// is point `p`'s domain, its scalars as cell data, so that ParaView draws the GIMP domains
 /// as the paper's figures do.
 pub fn domains_grid(frame: &DomainFrame) -> UnstructuredGrid {
-    const CORNERS: [[f64; 3]; 8] = [
-        [-1.0, -1.0, -1.0],
-        [1.0, -1.0, -1.0],
-        [1.0, 1.0, -1.0],
-        [-1.0, 1.0, -1.0],
-        [-1.0, -1.0, 1.0],
-        [1.0, -1.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [-1.0, 1.0, 1.0],
-    ];
+    // The Hex8 corners are in VTK order, and their first four are the quadrilateral's
+    // (counter-clockwise; a plane domain has no half-length along z).
+    let corners = HexElement::Hex8.local_nodes();
     let (k, kind) = if frame.dimension == 3 {
         (8, vtk::cell::HEXAHEDRON)
     } else {
@@ -201,7 +195,7 @@ pub fn domains_grid(frame: &DomainFrame) -> UnstructuredGrid {
     };
     let mut pts = Vec::with_capacity(k * frame.domains.len());
     for d in &frame.domains {
-        for c in &CORNERS[..k] {
+        for c in &corners[..k] {
             pts.push(std::array::from_fn(|a| d.centre[a] + c[a] * d.half[a]));
         }
     }
