@@ -8,7 +8,7 @@
 //! Builders: [`material_points`] (vertex cells with position, domain extent, volume, σ, τ, F,
 //! plastic multiplier, displacement), [`gauss_points`] (the same fields for FEM Gauss points,
 //! without domains), [`background_grid`] (lines / quads / hexahedra with nodal vectors) and
-//! [`line_mesh`] (an FEM line mesh with nodal displacement). Files are written with
+//! [`line_mesh`] and [`element_mesh`] (FEM meshes with nodal displacement). Files are written with
 //! [`crate::study::store::write_atomic`].
 //!
 //! # References
@@ -16,7 +16,7 @@
 //! collection format.
 
 use crate::atomic_file::write_atomic;
-use crate::fem::{LineElement, LineMesh};
+use crate::fem::{ElementFamily, ElementMesh, LineElement, LineMesh};
 use crate::grid::Grid;
 use crate::kinematics::PointState;
 use crate::particles::MaterialPoints;
@@ -31,6 +31,8 @@ pub mod cell {
     pub const QUAD: u8 = 9;
     pub const HEXAHEDRON: u8 = 12;
     pub const QUADRATIC_EDGE: u8 = 21;
+    pub const QUADRATIC_QUAD: u8 = 23;
+    pub const QUADRATIC_HEXAHEDRON: u8 = 25;
 }
 
 /// A named array of `components` values per point or per cell.
@@ -383,6 +385,40 @@ pub fn line_mesh(mesh: &LineMesh, mesh0: &LineMesh) -> UnstructuredGrid {
             .iter()
             .zip(&mesh0.nodes)
             .map(|(x, x0)| [x - x0, 0.0, 0.0]),
+    );
+    g
+}
+
+/// The VTK cell of an element with `nodes` nodes in `dim` dimensions: our Q4, Q8, Hex8 and
+/// Hex20 node tables are VTK's (corners, then mid-edge nodes in VTK's edge order).
+fn element_cell(dim: usize, nodes: usize) -> u8 {
+    match (dim, nodes) {
+        (2, 4) => cell::QUAD,
+        (2, 8) => cell::QUADRATIC_QUAD,
+        (3, 8) => cell::HEXAHEDRON,
+        (3, 20) => cell::QUADRATIC_HEXAHEDRON,
+        _ => unreachable!("no VTK cell for a {dim}D element of {nodes} nodes"),
+    }
+}
+
+/// A quadrilateral or hexahedral FEM mesh in its current configuration (`mesh`) with nodal
+/// `position0` and `displacement` relative to `mesh0`.
+pub fn element_mesh<const D: usize, E: ElementFamily<D>>(
+    mesh: &ElementMesh<D, E>,
+    mesh0: &ElementMesh<D, E>,
+) -> UnstructuredGrid {
+    let mut g = UnstructuredGrid {
+        points: mesh.nodes.iter().map(pad3).collect(),
+        ..UnstructuredGrid::default()
+    };
+    let kind = element_cell(D, mesh.element.nodes_per_element());
+    for e in 0..mesh.num_elements() {
+        g.push_cell(kind, mesh.element_nodes(e));
+    }
+    g.add_point_rows("position0", mesh0.nodes.iter().map(pad3));
+    g.add_point_rows(
+        "displacement",
+        mesh.nodes.iter().zip(&mesh0.nodes).map(|(x, x0)| pad3(&(x - x0))),
     );
     g
 }

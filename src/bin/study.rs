@@ -49,10 +49,10 @@ struct Cli {
     #[arg(long)]
     resume: bool,
     /// Write ParaView files `<out>/<name>/vtk/<case>.pvd` of the initial and the final state:
-    /// column, the material/Gauss points and the grid/mesh (1D only: column-3d writes none
-    /// yet); compaction, cantilever and manufactured, the material point domains
-    /// (quadrilaterals in 2D, hexahedra in compaction-3d and cantilever-3d) of the iGIMP and
-    /// MPM cases (FEM cases write none).
+    /// column and column-3d, the material/Gauss points and the grid/mesh of every case;
+    /// compaction, cantilever and manufactured (2D and 3D), the material point domains
+    /// (quadrilaterals in 2D, hexahedra in 3D) of the iGIMP and MPM cases with their
+    /// background grid (FEM cases write none).
     #[arg(long)]
     vtk: bool,
     /// With --vtk, also write every N-th load step (implies --vtk; column and cantilever;

@@ -185,14 +185,34 @@ impl CantileverSpec {
         }
     }
 
+    /// The plane-strain background grid: from the support (x = 0) to `grid_margin` past the
+    /// free end, `grid_below` under the beam to `grid_margin` above it.
+    pub fn grid_2d(&self) -> Result<Grid<2>, InputError> {
+        let h = self.element_size;
+        let x_cells = ((self.length + self.grid_margin) / h).round() as usize;
+        let y_cells = ((self.grid_below + self.depth + self.grid_margin) / h).round() as usize;
+        Grid::try_new([0.0, -self.grid_below], [h, h], [x_cells, y_cells])
+    }
+
+    /// The 3D background grid: the plane grid extended `grid_margin` to either side of the
+    /// beam's width.
+    pub fn grid_3d(&self) -> Result<Grid<3>, InputError> {
+        let h = self.element_size;
+        let m = self.grid_margin;
+        let cells = [
+            ((self.length + m) / h).round() as usize,
+            ((self.grid_below + self.depth + m) / h).round() as usize,
+            ((self.depth + 2.0 * m) / h).round() as usize,
+        ];
+        Grid::try_new([0.0, -self.grid_below, -m], [h; 3], cells)
+    }
+
     /// The plane-strain solver, and the indices of the two loaded points (below, above the
     /// neutral axis).
     pub fn mpm_solver(&self) -> Result<(MpmSolver<2>, [usize; 2]), InputError> {
         self.validate()?;
         let h = self.element_size;
-        let x_cells = ((self.length + self.grid_margin) / h).round() as usize;
-        let y_cells = ((self.grid_below + self.depth + self.grid_margin) / h).round() as usize;
-        let grid = Grid::try_new([0.0, -self.grid_below], [h, h], [x_cells, y_cells])?;
+        let grid = self.grid_2d()?;
         let ppc = self.points_per_cell;
         let points = MaterialPoints::fill_box(&grid, [0.0, 0.0], [self.length, self.depth], [ppc, ppc], 1.0)?;
         let axis_y = 0.5 * self.depth;
@@ -223,13 +243,7 @@ impl CantileverSpec {
     pub fn mpm_solver_3d(&self) -> Result<(MpmSolver<3>, Vec<usize>), InputError> {
         self.validate()?;
         let h = self.element_size;
-        let m = self.grid_margin;
-        let cells = [
-            ((self.length + m) / h).round() as usize,
-            ((self.grid_below + self.depth + m) / h).round() as usize,
-            ((self.depth + 2.0 * m) / h).round() as usize,
-        ];
-        let grid = Grid::try_new([0.0, -self.grid_below, -m], [h; 3], cells)?;
+        let grid = self.grid_3d()?;
         let ppc = self.points_per_cell;
         let d = self.depth;
         let points = MaterialPoints::fill_box(&grid, [0.0; 3], [self.length, d, d], [ppc; 3], 1.0)?;

@@ -451,9 +451,14 @@ impl ColumnSpec {
     }
 }
 
-fn solve_mpm_3d(spec: &ColumnSpec, basis: Basis) -> Result<ColumnOutcome, InputError> {
+fn solve_mpm_3d(
+    spec: &ColumnSpec,
+    basis: Basis,
+    observer: &mut ColumnObserver<'_>,
+) -> Result<ColumnOutcome, InputError> {
     let mut solver = spec.mpm_solver_3d(basis)?;
-    let (steps, failure) = match solver.run() {
+    observer(0, ColumnState::Mpm3(&solver));
+    let (steps, failure) = match solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Mpm3(s))) {
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
     };
@@ -567,6 +572,10 @@ impl ColumnOutcome {
 pub enum ColumnState<'a> {
     Mpm(&'a MpmSolver<1>),
     Fem(&'a LineFem),
+    /// The 3D prism (`dimension = 3`) by iGIMP or MPM.
+    Mpm3(&'a MpmSolver<3>),
+    /// The 3D prism by Hex8 or Hex20.
+    Fem3(&'a SolidFem),
 }
 
 /// Called with the load step number (0 before the first step) and the solver after the
@@ -586,10 +595,10 @@ pub fn solve_column_observed(
     observer: &mut ColumnObserver<'_>,
 ) -> Result<ColumnOutcome, InputError> {
     match (method, spec.dimension) {
-        (Method::Mpm, 3) => solve_mpm_3d(spec, Basis::Mpm),
-        (Method::Igimp, 3) => solve_mpm_3d(spec, Basis::Gimp),
-        (Method::FemHex8, 3) => solve_fem_3d(spec, HexElement::Hex8),
-        (Method::FemHex20, 3) => solve_fem_3d(spec, HexElement::Hex20),
+        (Method::Mpm, 3) => solve_mpm_3d(spec, Basis::Mpm, observer),
+        (Method::Igimp, 3) => solve_mpm_3d(spec, Basis::Gimp, observer),
+        (Method::FemHex8, 3) => solve_fem_3d(spec, HexElement::Hex8, observer),
+        (Method::FemHex20, 3) => solve_fem_3d(spec, HexElement::Hex20, observer),
         (_, 3) => Err(InputError::new(
             "dimension",
             3,
@@ -699,7 +708,11 @@ impl ColumnSpec {
 /// the value of the 1D element's Gauss point at that height (the strain is uniaxial), with
 /// volumes summing to the 1D point's, so eq (46), weighted by initial volume, is the 1D
 /// linear (Hex8) or quadratic (Hex20) FEM column's.
-fn solve_fem_3d(spec: &ColumnSpec, element: HexElement) -> Result<ColumnOutcome, InputError> {
+fn solve_fem_3d(
+    spec: &ColumnSpec,
+    element: HexElement,
+    observer: &mut ColumnObserver<'_>,
+) -> Result<ColumnOutcome, InputError> {
     spec.validate()?;
     let size = SVector::<f64, 3>::new(1.0, 1.0, spec.length);
     let mesh = HexMesh::cuboid(SVector::zeros(), size, [1, 1, spec.elements], element)?;
@@ -717,7 +730,8 @@ fn solve_fem_3d(spec: &ColumnSpec, element: HexElement) -> Result<ColumnOutcome,
         linear_solver: Default::default(),
     };
     let mut fem = SolidFem::try_new(mesh, spec.density, spec.model()?, fixed, loads, settings)?;
-    let (steps, failure) = match fem.run() {
+    observer(0, ColumnState::Fem3(&fem));
+    let (steps, failure) = match fem.run_observed(&mut |s, r| observer(r.step, ColumnState::Fem3(s))) {
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
     };

@@ -176,15 +176,20 @@ impl CompactionSpec {
         }
     }
 
-    /// The iGIMP/MPM solver of this problem.
-    pub fn mpm_solver(&self) -> Result<MpmSolver<2>, InputError> {
-        self.validate()?;
+    /// The plane-strain background grid: `grid_extent` from the origin in cells of h.
+    pub fn grid_2d(&self) -> Result<Grid<2>, InputError> {
         let h = self.element_size;
         let cells = [
             (self.grid_extent[0] / h).round() as usize,
             (self.grid_extent[1] / h).round() as usize,
         ];
-        let grid = Grid::try_new([0.0, 0.0], [h, h], cells)?;
+        Grid::try_new([0.0, 0.0], [h, h], cells)
+    }
+
+    /// The iGIMP/MPM solver of this problem.
+    pub fn mpm_solver(&self) -> Result<MpmSolver<2>, InputError> {
+        self.validate()?;
+        let grid = self.grid_2d()?;
         let ppc = self.points_per_cell;
         let points =
             MaterialPoints::fill_box(&grid, [0.0, 0.0], [self.half_width, self.height], [ppc, ppc], 1.0)?;
@@ -444,6 +449,12 @@ impl CompactionSpec {
         [nx, nx, nz]
     }
 
+    /// The 3D quarter block's background grid (cubic cells of h from the origin).
+    pub fn grid_3d(&self) -> Result<Grid<3>, InputError> {
+        let h = self.element_size;
+        Grid::try_new([0.0; 3], [h; 3], self.grid_cells_3d())
+    }
+
     /// The 3D quarter-block solver of this spec (iGIMP or MPM by `spec.basis`): the quarter
     /// of a square block of side 2 × `half_width` and height `height` (symmetry planes x = 0
     /// and y = 0 and the base z = 0 on rollers), on a cubic grid of `grid_extent[0]` ×
@@ -451,8 +462,7 @@ impl CompactionSpec {
     /// gravity along −z with the 2D unit weight.
     pub fn mpm_solver_3d(&self) -> Result<MpmSolver<3>, InputError> {
         self.validate()?;
-        let h = self.element_size;
-        let grid = Grid::try_new([0.0; 3], [h; 3], self.grid_cells_3d())?;
+        let grid = self.grid_3d()?;
         let ppc = self.points_per_cell;
         let points = MaterialPoints::fill_box(
             &grid,

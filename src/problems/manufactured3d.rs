@@ -27,6 +27,7 @@ use crate::mpm::{Loads, MpmSolver};
 use crate::particles::MaterialPoints;
 use nalgebra::{Matrix3, SVector};
 use num_dual::{Dual64, DualNum};
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 type V3 = SVector<f64, 3>;
@@ -117,27 +118,57 @@ impl Exact3 {
 }
 
 /// One material or Gauss point at the end of a 3D analysis.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PointValue3 {
+    /// Reference position X_p.
     pub x0: [f64; 3],
+    /// Current position x_p.
     pub x: [f64; 3],
+    /// Initial volume v_p0.
     pub volume0: f64,
-    pub sigma: Matrix3<f64>,
+    /// Cauchy stress, rows.
+    pub sigma: [[f64; 3]; 3],
+    /// Domain half-lengths (material points; zero for Gauss points), for ParaView.
+    pub half: [f64; 3],
+}
+
+impl PointValue3 {
+    pub fn cauchy(&self) -> Matrix3<f64> {
+        Matrix3::from_fn(|i, j| self.sigma[i][j])
+    }
+}
+
+fn rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
+    std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
+}
+
+/// Each point's ‖σ_p − σ(X_p)‖_F and σ_max, the largest exact ‖σ(X_p)‖_F: the summands and
+/// the scale of the stress measure (as [`super::manufactured::stress_deviations`] in 2D).
+pub fn stress_deviations_3d(exact: &Exact3, points: &[PointValue3]) -> (Vec<f64>, f64) {
+    let mut smax = 0.0_f64;
+    let deviation = points
+        .iter()
+        .map(|p| {
+            let se = exact.cauchy(p.x0);
+            smax = smax.max(se.norm());
+            (p.cauchy() - se).norm()
+        })
+        .collect();
+    (deviation, smax)
 }
 
 /// The measures of [`super::manufactured::errors`], in 3D: the relative discrete L2
 /// displacement error and Σ_p ‖σ_p − σ(X_p)‖_F v_p0 / (σ_max |Ω₀|).
 pub fn errors_3d(exact: &Exact3, points: &[PointValue3]) -> Errors {
-    let (mut num, mut den, mut serr, mut vol, mut smax) = (0.0, 0.0, 0.0, 0.0, 0.0_f64);
-    for p in points {
+    let (deviation, smax) = stress_deviations_3d(exact, points);
+    let (mut num, mut den, mut serr, mut vol) = (0.0, 0.0, 0.0, 0.0);
+    for (p, d) in points.iter().zip(&deviation) {
         let xe = exact.position(p.x0);
-        let se = exact.cauchy(p.x0);
-        smax = smax.max(se.norm());
         for a in 0..3 {
             num += p.volume0 * (p.x[a] - xe[a]).powi(2);
             den += p.volume0 * (xe[a] - p.x0[a]).powi(2);
         }
-        serr += (p.sigma - se).norm() * p.volume0;
+        serr += d * p.volume0;
         vol += p.volume0;
     }
     Errors {
@@ -151,8 +182,8 @@ pub fn errors_3d(exact: &Exact3, points: &[PointValue3]) -> Errors {
 pub struct Solution3 {
     pub steps: Vec<StepReport>,
     pub failure: Option<SolveError>,
-    /// Material or Gauss points.
-    pub points: usize,
+    /// Material or Gauss points at the last converged step.
+    pub points: Vec<PointValue3>,
     /// Errors of a converged analysis.
     pub errors: Option<Errors>,
 }
@@ -162,6 +193,13 @@ pub struct Solution3 {
 /// dead load carried by the points (Gauss points) as in 2D.
 pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, InputError> {
     spec.validate()?;
+    if spec.dimension != 3 {
+        return Err(InputError::new(
+            "dimension",
+            spec.dimension,
+            "solve_3d takes dimension 3; problems::manufactured::solve solves 2",
+        ));
+    }
     let exact = Exact3::of(spec);
     let model = || LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio).map(Box::new);
     let h = spec.element_size();
@@ -197,7 +235,8 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
                     x0: arr(&p.position0[i]),
                     x: arr(&p.position[i]),
                     volume0: p.volume0[i],
-                    sigma: p.state[i].cauchy(),
+                    sigma: rows(&p.state[i].cauchy()),
+                    half: arr(&p.half_length[i]),
                 })
                 .collect();
             (steps, failure, values)
@@ -246,7 +285,8 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
                         x0: [x0[0], x0[1], x0[2]],
                         x: [x[0], x[1], x[2]],
                         volume0: fem.gauss.volume0[g],
-                        sigma: fem.cauchy_stress(g),
+                        sigma: rows(&fem.cauchy_stress(g)),
+                        half: [0.0; 3],
                     }
                 })
                 .collect();
@@ -258,7 +298,7 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
     Ok(Solution3 {
         steps,
         failure,
-        points: values.len(),
+        points: values,
         errors,
     })
 }

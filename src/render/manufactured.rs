@@ -44,9 +44,15 @@ pub fn report_markdown(results: &Results) -> String {
         study.summary,
         results.provenance.line()
     );
+    let dim = study.dimension as usize;
+    let (body, boundary) = if dim == 3 {
+        ("cube", "face")
+    } else {
+        ("square", "edge")
+    };
     let _ = writeln!(
         s,
-        "Hencky elasticity E = {}, ν = {}; the unit square filled by material and grid; rollers on every edge; the manufactured body force ramped over {} load steps. Errors at the material (Gauss) points: displacement ‖x_p − x(X_p)‖ / ‖u(X_p)‖, stress Σ‖σ_p − σ(X_p)‖ v_p0 / (σ_max |Ω₀|). Rates are slopes of log(error) against log(h); pairwise rates in brackets.\n",
+        "Hencky elasticity E = {}, ν = {}; the unit {body} filled by material and grid; rollers on every {boundary}; the manufactured body force ramped over {} load steps. Errors at the material (Gauss) points: displacement ‖x_p − x(X_p)‖ / ‖u(X_p)‖, stress Σ‖σ_p − σ(X_p)‖ v_p0 / (σ_max |Ω₀|). Rates are slopes of log(error) against log(h); pairwise rates in brackets.\n",
         study.material.young_modulus, study.material.poisson_ratio, study.load_steps
     );
     for sw in &study.sweeps {
@@ -78,7 +84,7 @@ pub fn report_markdown(results: &Results) -> String {
             for ser in results.sweep_series(&sw.id) {
                 let cs = results.series_cases(&sw.id, &ser);
                 let pr = pairwise(&cs, m);
-                let _ = write!(s, "| {} |", ser.label());
+                let _ = write!(s, "| {} |", ser.label(dim));
                 for n in &cells {
                     match cs.iter().position(|c| c.cells == *n) {
                         Some(i) => {
@@ -109,7 +115,7 @@ pub fn report_markdown(results: &Results) -> String {
             s,
             "| {} | {} | {} | {:?} | {} | {} ± {} | {} |",
             r.sweep,
-            r.series.label(),
+            r.series.label(dim),
             r.measure.name(),
             r.cells_used,
             r2(r.slope),
@@ -158,7 +164,7 @@ fn render_figure(
                         .find(|r| r.sweep == f.sweep && r.series == ser && r.measure == m)
                         .and_then(|r| r.slope);
                     (points.len() >= 2).then(|| ConvergenceSeries {
-                        label: ser.label(),
+                        label: ser.label(results.study.dimension as usize),
                         points,
                         slope,
                     })

@@ -1,4 +1,6 @@
-//! `study --vtk`: ParaView files of each case of a column study.
+//! `study --vtk`: ParaView files of each case of a study: the column's solver states
+//! ([`ColumnVtkWriter`]) and the other kinds' material point domains with their background
+//! grid ([`write_domain_frames`]).
 //!
 //! Layout inside the study folder: `vtk/<case-id>.pvd` (a collection with time = load factor,
 //! part 0 the material or Gauss points, part 1 the background grid or FEM mesh) and
@@ -87,19 +89,17 @@ impl ColumnVtkWriter {
         }
         let (points, grid) = match state {
             ColumnState::Mpm(s) => {
-                let du = s.step_increment();
-                if step > 0 {
-                    self.total_du.resize(du.len(), 0.0);
-                    self.total_du.iter_mut().zip(du).for_each(|(t, d)| *t += d);
-                }
-                let zeros = vec![0.0; s.grid.num_nodes()];
-                let (inc, tot) = if step == 0 || du.len() != zeros.len() {
-                    (&zeros[..], &zeros[..])
-                } else {
-                    (du, &self.total_du[..])
-                };
-                let grid =
-                    vtk::background_grid(&s.grid, &[("displacement_increment", inc), ("displacement", tot)]);
+                let len = s.grid.num_nodes();
+                let grid = self.grid_with_displacement(step, len, s.step_increment(), |n, d| {
+                    vtk::background_grid(&s.grid, &[("displacement_increment", n), ("displacement", d)])
+                });
+                (vtk::material_points(&s.points), grid)
+            }
+            ColumnState::Mpm3(s) => {
+                let len = 3 * s.grid.num_nodes();
+                let grid = self.grid_with_displacement(step, len, s.step_increment(), |n, d| {
+                    vtk::background_grid(&s.grid, &[("displacement_increment", n), ("displacement", d)])
+                });
                 (vtk::material_points(&s.points), grid)
             }
             ColumnState::Fem(s) => {
@@ -111,6 +111,13 @@ impl ColumnVtkWriter {
                 let points = vtk::gauss_points(&x, &x0, &g.volume0, &g.state);
                 (points, vtk::line_mesh(&s.mesh, &s.mesh0))
             }
+            ColumnState::Fem3(s) => {
+                let g = &s.gauss;
+                let x: Vec<[f64; 3]> = (0..g.len()).map(|p| pad3(&s.gauss_point_position(p))).collect();
+                let x0: Vec<[f64; 3]> = g.position0.iter().map(pad3).collect();
+                let points = vtk::gauss_points(&x, &x0, &g.volume0, &g.state);
+                (points, vtk::element_mesh(&s.mesh, &s.mesh0))
+            }
         };
         let due = step == 0 || (self.options.every > 0 && step % self.options.every == 0);
         if due {
@@ -119,6 +126,25 @@ impl ColumnVtkWriter {
         } else {
             self.pending = Some((step, points, grid));
         }
+    }
+
+    /// The background grid built by `grid(increment, total)` with the nodal displacement
+    /// increment `du` of the step and the running sum Σ Δu, `len` values each (nodes × D);
+    /// zeros at step 0 and while the solver's increment is not of that size.
+    fn grid_with_displacement(
+        &mut self,
+        step: usize,
+        len: usize,
+        du: &[f64],
+        grid: impl Fn(&[f64], &[f64]) -> UnstructuredGrid,
+    ) -> UnstructuredGrid {
+        if step == 0 || du.len() != len {
+            let zeros = vec![0.0; len];
+            return grid(&zeros, &zeros);
+        }
+        self.total_du.resize(len, 0.0);
+        self.total_du.iter_mut().zip(du).for_each(|(t, d)| *t += d);
+        grid(du, &self.total_du)
     }
 
     fn write(&mut self, step: usize, points: &UnstructuredGrid, grid: &UnstructuredGrid) {
@@ -230,14 +256,25 @@ pub fn domains_grid(frame: &DomainFrame) -> UnstructuredGrid {
     g
 }
 
-/// Write `<study_dir>/vtk/<case_id>.pvd` and one `.vtu` per frame (`<case_id>/domains_<step>.vtu`),
-/// replacing stale files of the case.
+/// Write `<study_dir>/vtk/<case_id>.pvd` and one `.vtu` per frame (`<case_id>/domains_<step>.vtu`,
+/// part 0 of each time step), replacing stale files of the case. With `grid`, the background
+/// grid is written once (`<case_id>/grid.vtu`, its elements as quadrilaterals or hexahedra)
+/// and is part 1 of every time step: an MPM grid never moves, so one file serves them all.
 pub fn write_domain_frames(
     study_dir: &Path,
     case_id: &str,
     frames: &[DomainFrame],
+    grid: Option<&UnstructuredGrid>,
 ) -> Result<PathBuf, StudyError> {
     let case_dir = fresh_case_dir(study_dir, case_id)?;
+    let grid_file = match grid {
+        Some(g) => {
+            let path = case_dir.join("grid.vtu");
+            vtk::write_vtu(&path, g).map_err(|e| StudyError::io(&path, e))?;
+            Some(format!("{case_id}/grid.vtu"))
+        }
+        None => None,
+    };
     let mut entries = vec![];
     for f in frames {
         let name = format!("domains_{:05}.vtu", f.step);
@@ -248,6 +285,13 @@ pub fn write_domain_frames(
             part: 0,
             file: format!("{case_id}/{name}"),
         });
+        if let Some(file) = &grid_file {
+            entries.push(PvdEntry {
+                time: f.time,
+                part: 1,
+                file: file.clone(),
+            });
+        }
     }
     let path = pvd_path(study_dir, case_id)?;
     vtk::write_pvd(&path, &entries).map_err(|e| StudyError::io(&path, e))?;

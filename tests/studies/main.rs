@@ -4,6 +4,7 @@
 mod cantilever_study;
 mod column3d_study;
 mod compaction_study;
+mod manufactured3d_study;
 mod manufactured_study;
 mod study;
 mod three_d_studies;

@@ -236,6 +236,73 @@ fn vtk_output_read_by_meshio_matches_results_json_and_point_files() {
     }
 }
 
+/// The column as a 3D prism (`dimension = 3`) writes ParaView files as the 1D column does:
+/// iGIMP its points and its 1 × 1 × n background grid of hexahedra, Hex8 and Hex20 their Gauss
+/// points and their mesh (VTK hexahedra and quadratic hexahedra in our node order), at every
+/// step; the top displacement read back equals the solver's.
+#[test]
+fn column_3d_writes_points_and_hexahedral_grids_read_by_meshio() {
+    use igimp::method::Method;
+    use igimp::problems::column::{solve_column_observed, ColumnSpec};
+    use igimp::study::vtk_output::{ColumnVtkWriter, VtkOptions};
+    let tmp = tempfile::tempdir().unwrap();
+    let spec = ColumnSpec {
+        dimension: 3,
+        elements: 4,
+        load_steps: 2,
+        ..ColumnSpec::default()
+    };
+    for (method, cell, nodes) in [
+        (Method::Igimp, "hexahedron", 8),
+        (Method::FemHex8, "hexahedron", 8),
+        (Method::FemHex20, "hexahedron20", 20),
+    ] {
+        let id = method.name();
+        let mut w = ColumnVtkWriter::new(tmp.path(), id, spec.load_steps, VtkOptions { every: 1 }).unwrap();
+        let outcome =
+            solve_column_observed(&spec, method, &mut |step, state| w.observe(step, state)).unwrap();
+        assert!(outcome.failure.is_none(), "{id}");
+        let pvd = std::fs::read_to_string(w.finish().unwrap()).unwrap();
+        // Steps 0, 1 and 2, each with points and grid.
+        assert_eq!(pvd.matches("<DataSet").count(), 6, "{pvd}");
+        if !meshio_available() {
+            return;
+        }
+        let pts_file = tmp.path().join(format!("vtk/{id}/points_00002.vtu"));
+        let grid_file = tmp.path().join(format!("vtk/{id}/grid_00002.vtu"));
+        let all = meshio_read(&[pts_file.clone(), grid_file.clone()]);
+        let (pts, grid) = (
+            &all[pts_file.to_str().unwrap()],
+            &all[grid_file.to_str().unwrap()],
+        );
+        let cells = grid["cells"].as_array().unwrap();
+        assert_eq!(cells[0][0], cell, "{id}");
+        let conn = cells[0][1].as_array().unwrap();
+        assert_eq!(conn.len(), spec.elements, "{id}: one cell per element");
+        assert!(conn.iter().all(|c| c.as_array().unwrap().len() == nodes));
+        let n_points = pts["points"].as_array().unwrap().len();
+        assert_eq!(n_points, outcome.points.len(), "{id}");
+        let (z0, uz) = (column(pts, "position0", 2), column(pts, "displacement", 2));
+        let grid_uz = column(grid, "displacement", 2);
+        let top = if method == Method::Igimp {
+            let p = (0..n_points).max_by(|&a, &b| z0[a].total_cmp(&z0[b])).unwrap();
+            uz[p]
+        } else {
+            // Every top node of the prism moves alike (uniaxial strain).
+            grid_uz.iter().copied().fold(f64::INFINITY, f64::min)
+        };
+        assert!(
+            (top - outcome.top_displacement).abs() <= 1e-12 * outcome.top_displacement.abs(),
+            "{id}: {top} vs {}",
+            outcome.top_displacement
+        );
+        assert!(
+            grid_uz.iter().any(|&v| v < 0.0),
+            "{id}: grid displacement is written"
+        );
+    }
+}
+
 fn resumed_count(stderr: &str) -> (usize, usize) {
     let line = stderr
         .lines()
@@ -434,6 +501,10 @@ fn plane_studies_resume_and_write_vtk() {
     }
     let id = "igimp-elastic-h1-p2";
     let last = vtk.join(id).join("domains_00020.vtu");
+    assert!(
+        vtk.join(id).join("grid.vtu").is_file(),
+        "the background grid is written"
+    );
     let domains: Value =
         serde_json::from_slice(&std::fs::read(tmp.path().join("killed/compaction/domains.json")).unwrap())
             .unwrap();
@@ -556,11 +627,36 @@ fn vtk_3d_domains_are_hexahedra_read_by_meshio() {
         domains: domains.clone(),
         scalars: vec![("sigma_zz".into(), vec![-1.0, -2.0])],
     };
-    let pvd = write_domain_frames(tmp.path(), "case", &[frame]).unwrap();
-    assert!(pvd.is_file());
+    let grid = igimp::grid::Grid::<3>::try_new([0.0; 3], [0.5, 1.0, 0.25], [2, 1, 3]).unwrap();
+    let grid = igimp::vtk::background_grid(&grid, &[]);
+    let pvd = write_domain_frames(tmp.path(), "case", &[frame], Some(&grid)).unwrap();
+    // The background grid is part 1 of the time step.
+    let text = std::fs::read_to_string(&pvd).unwrap();
+    assert!(text.contains(r#"part="1" file="case/grid.vtu""#), "{text}");
     if !meshio_available() {
         return;
     }
+    let grid_file = tmp.path().join("vtk/case/grid.vtu");
+    let g = &meshio_read(std::slice::from_ref(&grid_file))[grid_file.to_str().unwrap()];
+    assert_eq!(g["cells"][0][0], "hexahedron");
+    assert_eq!(g["cells"][0][1].as_array().unwrap().len(), 6);
+    let top = g["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            [
+                p[0].as_f64().unwrap(),
+                p[1].as_f64().unwrap(),
+                p[2].as_f64().unwrap(),
+            ]
+        })
+        .fold([0.0f64; 3], |m, p| std::array::from_fn(|a| m[a].max(p[a])));
+    assert_eq!(
+        top,
+        [1.0, 1.0, 0.75],
+        "the grid spans 2 x 1 x 3 cells of 0.5 x 1 x 0.25"
+    );
     const SCRIPT: &str = r#"
 import json, sys, meshio
 m = meshio.read(sys.argv[1])

@@ -12,6 +12,7 @@ use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTa
 use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};
 use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
 use crate::study::{StudyError, Tier};
+use crate::vtk;
 use std::path::Path;
 
 /// The elastica of the beam: plane strain (EI = E/(1 − ν²) d³/12 per unit width) or plane
@@ -159,7 +160,7 @@ impl StudyKind for CantileverStudy {
 
 /// ParaView files of an iGIMP case: its domain snapshots (the initial state, every
 /// `--vtk-every` steps or the figure's interval, and the last converged step);
-/// quadrilaterals in 2D, every point's hexahedron in 3D.
+/// quadrilaterals in 2D, every point's hexahedron in 3D, with the background grid.
 fn write_case_vtk(
     dir: &Path,
     case: &CantileverCase,
@@ -197,5 +198,13 @@ fn write_case_vtk(
             })
             .collect()
     };
-    write_domain_frames(dir, &case.id, &frames).map(|_| ())
+    // A rejected spec has no grid: its (empty) frames are written alone.
+    let s = &case.spec;
+    let grid = if s.dimension == 3 {
+        s.grid_3d().map(|g| vtk::background_grid(&g, &[]))
+    } else {
+        s.grid_2d().map(|g| vtk::background_grid(&g, &[]))
+    }
+    .ok();
+    write_domain_frames(dir, &case.id, &frames, grid.as_ref()).map(|_| ())
 }

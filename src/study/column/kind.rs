@@ -111,8 +111,7 @@ impl StudyKind for StudySpec {
         CaseKey {
             id: case.id.clone(),
             hash: case_definition_hash(case),
-            // The 3D prism has no ParaView writer yet (`study --help` says so).
-            has_vtk: case.spec.dimension == 1,
+            has_vtk: true,
         }
     }
     fn cost(&self, c: &Case) -> f64 {

@@ -10,6 +10,7 @@ use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTa
 use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};
 use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
 use crate::study::{StudyError, Tier};
+use crate::vtk;
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -115,7 +116,8 @@ impl CompactionStudy {
 
 /// ParaView files of an iGIMP or MPM case: the initial domains and those of the last
 /// converged step (the vertical stress and the plastic multiplier as cell data):
-/// quadrilaterals in 2D, every point's hexahedron in 3D (`domains_3d`).
+/// quadrilaterals in 2D, every point's hexahedron in 3D (`domains_3d`), with the background
+/// grid.
 fn write_case_vtk(
     dir: &Path,
     case: &CompactionCase,
@@ -176,5 +178,13 @@ fn write_case_vtk(
             vec![(vertical.into(), stress), ("plastic_multiplier".into(), plastic)],
         ),
     ];
-    write_domain_frames(dir, &case.id, &frames).map(|_| ())
+    // A rejected spec has no grid: its (empty) frames are written alone.
+    let s = &case.spec;
+    let grid = if s.dimension == 3 {
+        s.grid_3d().map(|g| vtk::background_grid(&g, &[]))
+    } else {
+        s.grid_2d().map(|g| vtk::background_grid(&g, &[]))
+    }
+    .ok();
+    write_domain_frames(dir, &case.id, &frames, grid.as_ref()).map(|_| ())
 }

@@ -83,7 +83,7 @@ pub(super) fn checks(results: &ManufacturedResults) -> Vec<CheckRecord> {
             let what = format!(
                 "{} of {} in sweep `{}`, fitted over cells {:?}",
                 x.measure.label(),
-                s.label(),
+                s.label(results.study.dimension as usize),
                 x.sweep,
                 r.map_or(vec![], |r| r.cells_used.clone())
             );

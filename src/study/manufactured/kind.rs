@@ -5,23 +5,26 @@
 
 use super::records::{CasePoints, ManufacturedMeasures, ManufacturedRecord};
 use super::{FigureKind, ManufacturedCase, ManufacturedStudy};
+use crate::grid::Grid;
 use crate::method::Method;
-use crate::problems::manufactured::{solve, stress_deviations, Exact, PointValue};
+use crate::problems::manufactured::{solve, stress_deviations, Errors, Exact, PointValue};
+use crate::problems::manufactured3d::{solve_3d, stress_deviations_3d, Exact3, PointValue3};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{fresh_points_dir, write_case_data, CaseStatus, SolveRecord, SweepIndex};
 use crate::study::store::{confined, write_file};
-use crate::study::vtk_output::{write_domain_frames, DomainFrame};
+use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
 use crate::study::{StudyError, Tier};
+use crate::vtk;
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::path::Path;
 
 fn solve_case(case: &ManufacturedCase) -> (ManufacturedRecord, CasePoints) {
-    let (solved, o) = match solve(&case.spec, case.method) {
-        Err(e) => (SolveRecord::rejected(e), None),
-        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
+    let (solved, errors, points) = if case.spec.dimension == 3 {
+        solve_cube(case)
+    } else {
+        solve_square(case)
     };
-    let errors = o.as_ref().and_then(|o| o.errors);
     let mp = case.method.uses_material_points();
     let rec = ManufacturedRecord {
         id: case.id.clone(),
@@ -34,18 +37,57 @@ fn solve_case(case: &ManufacturedCase) -> (ManufacturedRecord, CasePoints) {
         failure: solved.failure,
         displacement_error: errors.map(|e| e.displacement),
         stress_error: errors.map(|e| e.stress),
-        points: o.as_ref().map_or(0, |o| o.points.len()),
+        points: points.points.len() + points.points_3d.len(),
         newton_iterations: solved.newton_iterations,
         steps: solved.steps,
     };
+    (rec, points)
+}
+
+type Solved = (SolveRecord, Option<Errors>, CasePoints);
+
+/// The plane case ([`solve`]).
+fn solve_square(case: &ManufacturedCase) -> Solved {
+    let (solved, o) = match solve(&case.spec, case.method) {
+        Err(e) => (SolveRecord::rejected(e), None),
+        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
+    };
+    let errors = o.as_ref().and_then(|o| o.errors);
     let points = o.map_or(vec![], |o| o.points);
     let (deviation, smax) = stress_deviations(&Exact::of(&case.spec), &points);
     let stress_error = deviation.into_iter().map(|d| d / smax).collect();
-    (rec, CasePoints { points, stress_error })
+    let points = CasePoints {
+        points,
+        stress_error,
+        points_3d: vec![],
+    };
+    (solved, errors, points)
+}
+
+/// The cube case ([`solve_3d`]).
+fn solve_cube(case: &ManufacturedCase) -> Solved {
+    let (solved, o) = match solve_3d(&case.spec, case.method) {
+        Err(e) => (SolveRecord::rejected(e), None),
+        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
+    };
+    let errors = o.as_ref().and_then(|o| o.errors);
+    let points_3d = o.map_or(vec![], |o| o.points);
+    let (deviation, smax) = stress_deviations_3d(&Exact3::of(&case.spec), &points_3d);
+    let stress_error = deviation.into_iter().map(|d| d / smax).collect();
+    let points = CasePoints {
+        points: vec![],
+        stress_error,
+        points_3d,
+    };
+    (solved, errors, points)
 }
 
 /// Header of the point files: reference and current position, initial volume, Cauchy stress.
 pub const POINTS_HEADER: &str = "X,Y,x,y,volume0,sigma_xx,sigma_yy,sigma_xy,sigma_zz";
+
+/// Header of the 3D point files.
+pub const POINTS_HEADER_3D: &str =
+    "X,Y,Z,x,y,z,volume0,sigma_xx,sigma_yy,sigma_zz,sigma_xy,sigma_yz,sigma_xz";
 
 /// One row per point, shortest round-trip formatting (the file re-reads exactly).
 pub fn points_csv(points: &[PointValue]) -> String {
@@ -57,6 +99,34 @@ pub fn points_csv(points: &[PointValue]) -> String {
             s,
             "{},{},{},{},{},{},{},{},{}",
             p.x0[0], p.x0[1], p.x[0], p.x[1], p.volume0, p.sigma[0], p.sigma[1], p.sigma[2], p.sigma[3]
+        );
+    }
+    s
+}
+
+/// The 3D point file: one row per point, shortest round-trip formatting.
+pub fn points_csv_3d(points: &[PointValue3]) -> String {
+    let mut s = String::with_capacity(200 * (points.len() + 1));
+    s.push_str(POINTS_HEADER_3D);
+    s.push('\n');
+    for p in points {
+        let (x0, x, t) = (p.x0, p.x, p.sigma);
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            x0[0],
+            x0[1],
+            x0[2],
+            x[0],
+            x[1],
+            x[2],
+            p.volume0,
+            t[0][0],
+            t[1][1],
+            t[2][2],
+            t[0][1],
+            t[1][2],
+            t[0][2]
         );
     }
     s
@@ -77,30 +147,20 @@ impl StudyKind for ManufacturedStudy {
         CaseKey::of_spec(&c.id, c.method, &c.spec, 0)
     }
     fn cost(&self, c: &ManufacturedCase) -> f64 {
+        let d = c.spec.dimension as i32;
         let n = c.spec.cells as f64;
-        let per_cell = if c.method.uses_material_points() {
-            (c.spec.points_per_cell * c.spec.points_per_cell) as f64
-        } else {
-            9.0
+        let per_cell = match c.method {
+            Method::Igimp | Method::Mpm => (c.spec.points_per_cell as f64).powi(d),
+            // Gauss points, and a Hex20 point couples 60 × 60 unknowns (8 × Hex8's 24 × 24).
+            Method::FemHex20 => 27.0 * 6.0,
+            _ => 3f64.powi(d),
         };
-        n * n * per_cell
+        n.powi(d) * per_cell
     }
     fn solve(&self, c: &ManufacturedCase, vtk: Option<&VtkTarget>) -> Result<Self::Output, StudyError> {
         let out = solve_case(c);
         if let Some(v) = vtk {
-            let p = &out.1;
-            let frame = DomainFrame {
-                time: 1.0,
-                step: out.0.steps.len(),
-                dimension: 2,
-                domains: p
-                    .points
-                    .iter()
-                    .map(|q| [q.x[0], q.x[1], q.half[0], q.half[1]].into())
-                    .collect(),
-                scalars: vec![("stress_error".into(), p.stress_error.clone())],
-            };
-            write_domain_frames(&v.study_dir, &c.id, &[frame])?;
+            write_case_vtk(&v.study_dir, c, &out)?;
         }
         Ok(out)
     }
@@ -117,11 +177,56 @@ impl StudyKind for ManufacturedStudy {
         let pdir = fresh_points_dir(dir)?;
         for (r, p) in outputs.iter().filter(|(r, _)| r.status == CaseStatus::Converged) {
             let path = confined(&pdir, &format!("{}.csv", r.id))?;
-            write_file(&path, points_csv(&p.points).as_bytes())?;
+            let csv = if p.points_3d.is_empty() {
+                points_csv(&p.points)
+            } else {
+                points_csv_3d(&p.points_3d)
+            };
+            write_file(&path, csv.as_bytes())?;
         }
         let drawn = self.drawn_cases();
         write_case_data(&dir.join("domains.json"), outputs, |r, _| drawn.contains(&r.id))
     }
+}
+
+/// ParaView files of a case: its final domains (quadrilaterals in 2D, hexahedra in 3D; Gauss
+/// points have none) with each point's stress error, and the background grid.
+fn write_case_vtk(
+    dir: &Path,
+    c: &ManufacturedCase,
+    (rec, p): &(ManufacturedRecord, CasePoints),
+) -> Result<(), StudyError> {
+    let d = c.spec.dimension;
+    let domains: Vec<DomainBox> = if d == 3 {
+        p.points_3d
+            .iter()
+            .map(|q| DomainBox {
+                centre: q.x,
+                half: q.half,
+            })
+            .collect()
+    } else {
+        p.points
+            .iter()
+            .map(|q| [q.x[0], q.x[1], q.half[0], q.half[1]].into())
+            .collect()
+    };
+    let frame = DomainFrame {
+        time: 1.0,
+        step: rec.steps.len(),
+        dimension: d,
+        domains,
+        scalars: vec![("stress_error".into(), p.stress_error.clone())],
+    };
+    let (h, n) = (c.spec.element_size(), c.spec.cells);
+    // A rejected spec has no grid: its (empty) frame is written alone.
+    let grid = if d == 3 {
+        Grid::try_new([0.0; 3], [h; 3], [n; 3]).map(|g| vtk::background_grid(&g, &[]))
+    } else {
+        Grid::try_new([0.0; 2], [h; 2], [n; 2]).map(|g| vtk::background_grid(&g, &[]))
+    }
+    .ok();
+    write_domain_frames(dir, &c.id, &[frame], grid.as_ref()).map(|_| ())
 }
 
 impl ManufacturedStudy {

@@ -72,6 +72,14 @@ pub struct ManufacturedSweep {
     pub quick: SweepQuick,
 }
 
+fn plane() -> i64 {
+    2
+}
+
+fn is_plane(d: &i64) -> bool {
+    *d == 2
+}
+
 fn default_updates() -> Vec<DomainUpdate> {
     vec![DomainUpdate::Stretch]
 }
@@ -161,6 +169,10 @@ pub struct ManufacturedStudy {
     /// Always "manufactured".
     pub problem: String,
     pub report_file: String,
+    /// 2 (the unit square, plane strain; the default) or 3 (the unit cube: methods mpm,
+    /// igimp, fem-hex8, fem-hex20; points_per_cell³ points per cell; no domain figures).
+    #[serde(default = "plane", skip_serializing_if = "is_plane")]
+    pub dimension: i64,
     pub material: MaterialSection,
     pub amplitude: AmplitudeSection,
     pub load_steps: i64,

@@ -5,14 +5,22 @@ use super::{FigureKind, ManufacturedCase, ManufacturedStudy, ManufacturedSweep};
 use crate::method::Method;
 use crate::mpm::DomainUpdate;
 use crate::problems::manufactured::{Field, ManufacturedSpec, METHODS};
+use crate::problems::manufactured3d::METHODS_3D;
 use crate::study::engine::distinct_cases;
 use crate::study::results::SweepIndex;
 use crate::study::vocabulary::{max_points_per_axis, Checker, Header};
 use crate::study::{StudyError, Tier};
 use std::collections::BTreeSet;
 
-/// Most cells per side of one case (h = 1/512: 262,144 cells).
-const MAX_CELLS: i64 = 512;
+/// Most cells per side of one case: h = 1/512 in 2D (262,144 cells), 1/64 in 3D (262,144
+/// cells, ~2e6 points at 2×2×2: the direct solver's limit, README "Measured").
+const fn max_cells(dimension: i64) -> i64 {
+    if dimension == 3 {
+        64
+    } else {
+        512
+    }
+}
 
 /// The short name of a domain update in case ids.
 pub fn update_tag(u: DomainUpdate) -> &'static str {
@@ -41,6 +49,10 @@ impl ManufacturedStudy {
             summary: &self.summary,
             report_file: &self.report_file,
         })?;
+        if !matches!(self.dimension, 2 | 3) {
+            return Err(chk.err("dimension", self.dimension, "must be 2 or 3"));
+        }
+        let (dimension, methods) = (self.dimension, self.methods());
         chk.count("load_steps", self.load_steps, 1, 10_000)?;
         chk.newton("newton", &self.newton)?;
         chk.non_empty("sweeps", &self.sweeps)?;
@@ -64,14 +76,19 @@ impl ManufacturedStudy {
                 chk.non_empty(&k("cells"), &plan.cells)?;
                 chk.non_empty(&k("points_per_cell"), &plan.points_per_cell)?;
                 for (j, m) in plan.methods.iter().enumerate() {
-                    m.expect_one_of("manufactured problem", &METHODS)
+                    m.expect_one_of(self.problem_name(), methods)
                         .map_err(|e| chk.err(k(&format!("methods[{j}]")), m.name(), e.allowed))?;
                 }
                 for (j, &n) in plan.cells.iter().enumerate() {
-                    chk.count(&k(&format!("cells[{j}]")), n, 1, MAX_CELLS)?;
+                    chk.count(&k(&format!("cells[{j}]")), n, 1, max_cells(dimension))?;
                 }
                 for (j, &p) in plan.points_per_cell.iter().enumerate() {
-                    chk.count(&k(&format!("points_per_cell[{j}]")), p, 1, max_points_per_axis(2))?;
+                    chk.count(
+                        &k(&format!("points_per_cell[{j}]")),
+                        p,
+                        1,
+                        max_points_per_axis(dimension as u32),
+                    )?;
                 }
                 for c in self.sweep_cases(s, &plan) {
                     c.spec.validate().map_err(|e| {
@@ -138,6 +155,13 @@ impl ManufacturedStudy {
                         "convergence figures need a measure",
                     ))
                 }
+                FigureKind::Domains if dimension == 3 => {
+                    return Err(chk.err(
+                        format!("figures[{i}].kind"),
+                        "domains",
+                        "is a plane (dimension = 2) figure; `study --vtk` writes the 3D domains",
+                    ))
+                }
                 FigureKind::Domains if f.cells.is_none() || f.points_per_cell.is_none() => {
                     return Err(chk.err(
                         format!("figures[{i}]"),
@@ -149,6 +173,23 @@ impl ManufacturedStudy {
             }
         }
         Ok(())
+    }
+
+    /// The methods of the study's dimension.
+    pub fn methods(&self) -> &'static [Method] {
+        if self.dimension == 3 {
+            &METHODS_3D
+        } else {
+            &METHODS
+        }
+    }
+
+    fn problem_name(&self) -> &'static str {
+        if self.dimension == 3 {
+            "3D manufactured problem (dimension = 3)"
+        } else {
+            "manufactured problem (dimension = 2)"
+        }
     }
 
     pub(super) fn plan(&self, s: &ManufacturedSweep, tier: Tier) -> Option<SweepPlan> {
@@ -187,6 +228,7 @@ impl ManufacturedStudy {
             load_steps: self.load_steps.max(1) as usize,
             newton: self.newton.settings(),
             domain_update: update,
+            dimension: self.dimension.clamp(2, 3) as usize,
         }
     }
 

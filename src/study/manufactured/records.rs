@@ -5,6 +5,7 @@ use super::{ErrorMeasure, ManufacturedStudy};
 use crate::method::Method;
 use crate::mpm::DomainUpdate;
 use crate::problems::manufactured::{Field, PointValue};
+use crate::problems::manufactured3d::PointValue3;
 use crate::study::results::{case_record, CaseStatus, Envelope, FailureRecord, StepRecord};
 use serde::{Deserialize, Serialize};
 
@@ -60,7 +61,8 @@ impl Series {
         }
     }
 
-    pub fn label(&self) -> String {
+    /// The series' name in tables and legends; `dimension` (2 or 3) counts the points per cell.
+    pub fn label(&self, dimension: usize) -> String {
         let mut s = self.method.label().to_string();
         if let Some(u) = self.domain_update {
             s.push_str(match u {
@@ -70,7 +72,8 @@ impl Series {
             });
         }
         if let Some(p) = self.points_per_cell {
-            s.push_str(&format!(", {p}×{p} points"));
+            let per_cell = vec![p.to_string(); dimension.max(1)].join("×");
+            s.push_str(&format!(", {per_cell} points"));
         }
         s
     }
@@ -108,11 +111,13 @@ pub struct ManufacturedMeasures {
 pub type ManufacturedResults = Envelope<ManufacturedStudy, ManufacturedRecord, ManufacturedMeasures>;
 
 /// A case's points and each one's stress error ‖σ_p − σ(X_p)‖_F / σ_max (the summand of the
-/// stress measure, for the domain figures).
+/// stress measure, for the domain figures and ParaView): `points` in 2D, `points_3d` in 3D.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CasePoints {
     pub points: Vec<PointValue>,
     pub stress_error: Vec<f64>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub points_3d: Vec<PointValue3>,
 }
 
 impl ManufacturedResults {
