@@ -354,6 +354,9 @@ impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
             .as_deref()
             .map_or(0.0, |l| l.oob.iter().map(|x| x * x).sum())
     }
+    fn set_linear_tolerance(&mut self, relative: f64) {
+        self.matrix.set_tolerance(relative);
+    }
     fn solve_tangent(&mut self, rhs: &mut [f64]) -> Result<(), StepFailure> {
         self.assemble_tangent();
         self.matrix.solve_in_place(rhs).map_err(StepFailure::Singular)
@@ -396,6 +399,13 @@ pub struct StepWorkspace<const D: usize> {
     pub fixed_forces: Vec<f64>,
     /// Linearised reactions ([`ResidualNorm::Linearised`]).
     pub linearised: LinearisedReactions,
+    /// Where the nodes sit, for an iterative solver's multigrid
+    /// ([`crate::linear::LinearSolver::Cg`]); set by the solver before each step.
+    pub node_geometry: Option<crate::multigrid::NodeGeometry>,
+    /// The connectivity never changes (FEM): the sparsity pattern, its symbolic factorisation
+    /// and the equations' geometry are built at the first step and kept, as long as the
+    /// number of equations stays the same.
+    pub fixed_pattern: bool,
 }
 
 /// What a load step applies, besides the material model and the committed states.
@@ -417,7 +427,8 @@ pub struct StepInput<'a, const D: usize> {
 
 impl<const D: usize> StepWorkspace<D> {
     /// From the filled [`Self::table`]: the dof map, sparsity pattern (and so a fresh symbolic
-    /// factorisation) and external force of one load step; the resulting system is handed to `f`.
+    /// factorisation, unless [`Self::fixed_pattern`] keeps the first step's) and external
+    /// force of one load step; the resulting system is handed to `f`.
     pub fn with_system<R>(
         &mut self,
         input: &StepInput<'_, D>,
@@ -434,11 +445,22 @@ impl<const D: usize> StepWorkspace<D> {
         f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
     ) -> R {
         let dofs = DofMap::build(input.num_nodes, &self.table, input.fixed, input.ties);
-        let mut columns = dofs.pattern(&self.table);
-        if let Some(g) = input.ghost {
-            g.add_pattern(&dofs, &mut columns);
+        let kept = self.fixed_pattern && self.matrix.nnz() > 0 && self.matrix.dim() == dofs.len();
+        if kept {
+            self.matrix.clear_values();
+        } else {
+            let mut columns = dofs.pattern(&self.table);
+            if let Some(g) = input.ghost {
+                g.add_pattern(&dofs, &mut columns);
+            }
+            self.matrix.set_pattern(columns);
         }
-        self.matrix.set_pattern(columns);
+        if !kept && self.matrix.solver() == crate::linear::LinearSolver::Cg {
+            if let Some(g) = &self.node_geometry {
+                self.matrix
+                    .set_geometry(crate::multigrid::DofGeometry::of_equations(g, &dofs));
+            }
+        }
         let mut nodal = vec![0.0; dofs.num_dofs()];
         map_point_forces(&self.table, input.point_forces, &mut nodal);
         for &(dof, force) in input.nodal_forces {

@@ -50,6 +50,7 @@ pub mod linear;
 pub mod load_stepping;
 pub mod method;
 pub mod mpm;
+pub mod multigrid;
 pub mod newton;
 pub mod norms;
 pub mod particles;

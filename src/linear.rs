@@ -1,7 +1,9 @@
 //! Sparse tangent storage and solves (faer). The pattern is built once per load step from
-//! the point–node connectivity, which is fixed within a step; the symbolic factorisation
-//! is computed once for that pattern and only the numeric factorisation is repeated at each
-//! Newton iteration.
+//! the point–node connectivity, which is fixed within a step (once per analysis for FEM,
+//! whose connectivity never changes: [`crate::assembly::StepWorkspace::fixed_pattern`]); the
+//! symbolic factorisation is computed once for that pattern and only the numeric
+//! factorisation is repeated at each Newton iteration. [`LinearSolver::Cg`] solves
+//! iteratively instead, preconditioned by the grid's multigrid ([`crate::multigrid`]).
 //!
 //! The factorisation is LU by default. The tangent of a hyperelastic problem, and of
 //! associative perfect plasticity with its consistent tangent, is symmetric, so
@@ -33,6 +35,32 @@ pub enum LinearSolver {
     Ldlt,
     /// Sparse Cholesky LLᵀ of the lower triangle (symmetric positive definite), LU on failure.
     Llt,
+    /// Conjugate gradients preconditioned by a geometric multigrid V-cycle on the structured
+    /// grid ([`crate::multigrid`]), to the relative tolerance the Newton solver sets from its
+    /// residual ([`SparseSystem::set_tolerance`]); needs the equations' positions
+    /// ([`SparseSystem::set_geometry`]). Symmetric positive definite tangents only: if CG
+    /// breaks down or does not converge, the system is solved by LDLᵀ (then LU) and the
+    /// fallback is counted.
+    Cg,
+}
+
+/// Default relative tolerance of an iterative solve when no Newton solver has set one.
+pub const DEFAULT_ITERATIVE_TOLERANCE: f64 = 1e-10;
+/// Most CG iterations of one solve before it falls back to the direct solver.
+pub const MAX_CG_ITERATIONS: usize = 500;
+
+/// What the linear solves of a system have cost so far (for the performance figures).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LinearStats {
+    pub solves: usize,
+    /// CG iterations summed over the iterative solves.
+    pub iterations: usize,
+    /// Seconds in symbolic analysis, numeric factorisation or multigrid set-up.
+    pub setup_seconds: f64,
+    /// Seconds in triangular solves or Krylov iterations.
+    pub solve_seconds: f64,
+    /// Non-zeros of the last factor (direct solves).
+    pub factor_nnz: usize,
 }
 
 /// A square sparse matrix in compressed sparse column form with cached symbolic
@@ -49,6 +77,11 @@ pub struct SparseSystem {
     /// Numeric factor values of the symmetric factorisation, reused between iterations.
     factor: Vec<f64>,
     fallbacks: usize,
+    /// Where the equations sit ([`LinearSolver::Cg`]).
+    geometry: Option<crate::multigrid::DofGeometry>,
+    /// Relative residual an iterative solve must reach (0: the default).
+    tolerance: f64,
+    stats: LinearStats,
 }
 
 /// A contiguous range of columns of a [`SparseSystem`] whose values one thread may update
@@ -157,9 +190,27 @@ impl SparseSystem {
         self.solver
     }
 
-    /// How many solves fell back from a symmetric factorisation to LU.
+    /// How many solves fell back from a symmetric factorisation to LU, or from CG to a direct
+    /// solve.
     pub fn fallbacks(&self) -> usize {
         self.fallbacks
+    }
+
+    /// The positions and components of the equations, for the multigrid of
+    /// [`LinearSolver::Cg`] (kept until the next [`Self::set_geometry`]).
+    pub fn set_geometry(&mut self, geometry: crate::multigrid::DofGeometry) {
+        self.geometry = Some(geometry);
+    }
+
+    /// The relative residual ‖b − K x‖ / ‖b‖ an iterative solve must reach (the Newton
+    /// solver ties it to its own residual); ignored by the direct solvers.
+    pub fn set_tolerance(&mut self, relative: f64) {
+        self.tolerance = relative;
+    }
+
+    /// The cost of the solves so far.
+    pub fn stats(&self) -> LinearStats {
+        self.stats
     }
 
     pub fn dim(&self) -> usize {
@@ -216,6 +267,107 @@ impl SparseSystem {
         if self.n == 0 {
             return Ok(());
         }
+        self.stats.solves += 1;
+        if self.solver == LinearSolver::Cg {
+            let original = rhs.to_vec();
+            match self.solve_cg(rhs) {
+                Ok(()) if rhs.iter().all(|v| v.is_finite()) => return Ok(()),
+                _ => {
+                    self.fallbacks += 1;
+                    rhs.copy_from_slice(&original);
+                    let solver = std::mem::replace(&mut self.solver, LinearSolver::Ldlt);
+                    let out = self.solve_direct(rhs);
+                    self.solver = solver;
+                    return out;
+                }
+            }
+        }
+        self.solve_direct(rhs)
+    }
+
+    /// The pattern and values as a row-compressed matrix (the transpose of the stored
+    /// column-compressed one).
+    pub fn to_csr(&self) -> crate::multigrid::Csr {
+        crate::multigrid::Csr {
+            rows: self.n,
+            cols: self.n,
+            ptr: self.col_ptr.clone(),
+            idx: self.row_idx.clone(),
+            val: self.values.clone(),
+        }
+        .transpose()
+    }
+
+    fn solve_cg(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        use crate::multigrid::{pcg, Hierarchy};
+        let geometry = self
+            .geometry
+            .as_ref()
+            .ok_or("the CG solver needs the equations' positions (SparseSystem::set_geometry)")?;
+        let start = std::time::Instant::now();
+        let a = self.to_csr();
+        let mut m = Hierarchy::build(a.clone(), geometry)?;
+        self.stats.setup_seconds += start.elapsed().as_secs_f64();
+        let start = std::time::Instant::now();
+        let b = rhs.to_vec();
+        let rtol = if self.tolerance > 0.0 {
+            self.tolerance
+        } else {
+            DEFAULT_ITERATIVE_TOLERANCE
+        };
+        let report = pcg(&a, &mut m, &b, rhs, rtol, MAX_CG_ITERATIONS);
+        self.stats.solve_seconds += start.elapsed().as_secs_f64();
+        self.stats.iterations += report.as_ref().map_or(MAX_CG_ITERATIONS, |r| r.iterations);
+        report.map(|_| ())
+    }
+
+    /// Factorise (symmetric solvers: LDLᵀ or LLᵀ) for later [`Self::solve_factorized`].
+    pub fn factorize(&mut self) -> Result<(), String> {
+        if self.n == 0 {
+            return Ok(());
+        }
+        if !matches!(self.solver, LinearSolver::Ldlt | LinearSolver::Llt) {
+            return Err("factorize: LDLᵀ or LLᵀ only".into());
+        }
+        self.factorize_symmetric()
+    }
+
+    /// Solve with the factor of the last [`Self::factorize`].
+    pub fn solve_factorized(&self, rhs: &mut [f64]) -> Result<(), String> {
+        if self.n == 0 {
+            return Ok(());
+        }
+        let symbolic = self
+            .symbolic_cholesky
+            .as_ref()
+            .ok_or("solve_factorized: not factorised")?;
+        let par = faer::get_global_parallelism();
+        let scratch = symbolic.solve_in_place_scratch::<f64>(1, par);
+        let mut buf = MemBuffer::try_new(scratch).map_err(|e| format!("{e:?}"))?;
+        let stack = MemStack::new(&mut buf);
+        let n = self.n;
+        let mat = MatMut::from_column_major_slice_mut(rhs, n, 1);
+        match self.solver {
+            LinearSolver::Llt => {
+                LltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, mat, par, stack)
+            }
+            _ => LdltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, mat, par, stack),
+        }
+        if rhs.iter().all(|v| v.is_finite()) {
+            Ok(())
+        } else {
+            Err("the solution of the linear system is not finite (singular tangent)".into())
+        }
+    }
+
+    fn solve_direct(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        let start = std::time::Instant::now();
+        let out = self.solve_direct_untimed(rhs);
+        self.stats.setup_seconds += start.elapsed().as_secs_f64();
+        out
+    }
+
+    fn solve_direct_untimed(&mut self, rhs: &mut [f64]) -> Result<(), String> {
         if self.solver != LinearSolver::Lu {
             let original = rhs.to_vec();
             match self.solve_symmetric(rhs) {
@@ -247,9 +399,15 @@ impl SparseSystem {
         Ok(())
     }
 
+    /// LDLᵀ or LLᵀ of the lower triangle, then the solve.
+    fn solve_symmetric(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        self.factorize_symmetric()?;
+        self.solve_factorized(rhs)
+    }
+
     /// LDLᵀ or LLᵀ of the lower triangle (faer's supernodal/simplicial Cholesky with an AMD
     /// ordering), symbolic analysis cached per pattern.
-    fn solve_symmetric(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn factorize_symmetric(&mut self) -> Result<(), String> {
         let n = self.n;
         if self.symbolic_cholesky.is_none() {
             let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
@@ -267,33 +425,45 @@ impl SparseSystem {
             &self.values,
         );
         self.factor.resize(symbolic.len_val(), 0.0);
+        self.stats.factor_nnz = symbolic.len_val();
         let par = faer::get_global_parallelism();
-        let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
         let ldlt = match self.solver {
             LinearSolver::Ldlt => true,
             LinearSolver::Llt => false,
-            LinearSolver::Lu => unreachable!("LU is not a symmetric factorisation"),
+            _ => unreachable!("not a symmetric factorisation"),
         };
-        let factor_scratch = if ldlt {
+        let scratch = if ldlt {
             symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default())
         } else {
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default())
         };
-        let scratch = factor_scratch.or(symbolic.solve_in_place_scratch::<f64>(1, par));
         let mut buf = MemBuffer::try_new(scratch).map_err(|e| format!("{e:?}"))?;
         let stack = MemStack::new(&mut buf);
-        let (side, reg) = (Side::Lower, Default::default());
+        let side = Side::Lower;
         if ldlt {
             symbolic
-                .factorize_numeric_ldlt(&mut self.factor, mat, side, reg, par, stack, Default::default())
+                .factorize_numeric_ldlt(
+                    &mut self.factor,
+                    mat,
+                    side,
+                    Default::default(),
+                    par,
+                    stack,
+                    Default::default(),
+                )
                 .map_err(|e| format!("{e:?}"))?;
-            LdltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, rhs, par, stack);
         } else {
-            let reg = Default::default();
             symbolic
-                .factorize_numeric_llt(&mut self.factor, mat, side, reg, par, stack, Default::default())
+                .factorize_numeric_llt(
+                    &mut self.factor,
+                    mat,
+                    side,
+                    Default::default(),
+                    par,
+                    stack,
+                    Default::default(),
+                )
                 .map_err(|e| format!("{e:?}"))?;
-            LltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, rhs, par, stack);
         }
         Ok(())
     }

@@ -232,6 +232,17 @@ impl<const D: usize> MpmSolver<D> {
     /// Nodal displacement increment Δu of the last converged load step (node-major:
     /// `node * D + axis`; empty before the first step). The grid is reset every step, so this
     /// is the only nodal displacement the solver has.
+    /// What the linear solves have cost so far (solves, CG iterations, seconds) and how
+    /// many fell back to another solver.
+    pub fn linear_stats(&self) -> (crate::linear::LinearStats, usize) {
+        (self.work.matrix.stats(), self.work.matrix.fallbacks())
+    }
+
+    /// Unknowns and non-zeros of the last tangent.
+    pub fn system_size(&self) -> (usize, usize) {
+        (self.work.matrix.dim(), self.work.matrix.nnz())
+    }
+
     pub fn step_increment(&self) -> &[f64] {
         &self.work.du_nodal
     }
@@ -453,6 +464,10 @@ impl<const D: usize> MpmSolver<D> {
 impl<const D: usize> LoadStepping for MpmSolver<D> {
     fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
         let step = self.prepare_step(load_factor).map_err(|f| (f, vec![]))?;
+        if self.settings.linear_solver == crate::linear::LinearSolver::Cg && self.work.node_geometry.is_none()
+        {
+            self.work.node_geometry = Some(crate::multigrid::NodeGeometry::of_grid(&self.grid));
+        }
         let input = step_input!(self, step);
         self.work.matrix.set_solver(self.settings.linear_solver);
         let report = self.work.solve(&input, &self.settings.newton)?;

@@ -110,6 +110,9 @@ pub trait NonlinearSystem {
     fn evaluate(&mut self, u: &[f64], residual: &mut [f64]) -> Result<(), StepFailure>;
     /// Solve `K x = rhs` in place with the tangent formed at the last `evaluate`.
     fn solve_tangent(&mut self, rhs: &mut [f64]) -> Result<(), StepFailure>;
+    /// The relative residual an iterative linear solve must reach next ([`linear_tolerance`]);
+    /// direct solvers ignore it.
+    fn set_linear_tolerance(&mut self, _relative: f64) {}
     /// Norm that normalises the residual, from the last `evaluate` (for
     /// [`ResidualNorm::Total`] the reactions change with the iterate).
     fn reference_norm(&self, norm: ResidualNorm) -> f64;
@@ -181,6 +184,7 @@ pub fn solve(
         for (d, ri) in delta.iter_mut().zip(&r) {
             *d = -ri;
         }
+        system.set_linear_tolerance(linear_tolerance(res));
         if let Err(f) = system.solve_tangent(&mut delta) {
             return Err((f, history));
         }
@@ -267,6 +271,14 @@ fn detect_stall(history: &[f64], tolerance: f64) -> Option<StepFailure> {
 
 /// Most step halvings of the backtracking line search.
 const MAX_HALVINGS: usize = 10;
+
+/// The forcing term of an inexact Newton step at normalised residual `res`: the linear solve
+/// must reduce its residual by η = 10⁻² · res (at most 10⁻², at least 10⁻¹¹). The error it
+/// leaves adds η ‖r‖ ∝ ‖r‖² to the next residual, so the quadratic rate survives (Eisenstat
+/// & Walker 1996, choice with η_k ∝ ‖r_k‖); the floor keeps CG above round-off.
+pub fn linear_tolerance(res: f64) -> f64 {
+    (1e-2 * res).clamp(1e-11, 1e-2)
+}
 
 /// Observed convergence order from three successive residuals, ln(r3/r2)/ln(r2/r1).
 pub fn observed_order(r1: f64, r2: f64, r3: f64) -> f64 {

@@ -33,11 +33,13 @@ pub fn ghost_from_env() -> GhostSettings {
     g
 }
 
-/// `SCALING_SOLVER=lu|llt|ldlt` (default LDLᵀ).
+/// `SCALING_SOLVER=lu|llt|ldlt|cg` (default LDLᵀ; cg: multigrid-preconditioned CG to the
+/// relative residual 1e-8, a mid-Newton forcing term).
 pub fn solver_from_env() -> LinearSolver {
     match std::env::var("SCALING_SOLVER").as_deref() {
         Ok("lu") => LinearSolver::Lu,
         Ok("llt") => LinearSolver::Llt,
+        Ok("cg") => LinearSolver::Cg,
         _ => LinearSolver::Ldlt,
     }
 }
@@ -77,6 +79,11 @@ pub fn time_iteration<const D: usize>(
     }
     matrix.set_pattern(columns);
     matrix.set_solver(solver);
+    if solver == LinearSolver::Cg {
+        let nodes = igimp::multigrid::NodeGeometry::of_grid(&solver_mpm.grid);
+        matrix.set_geometry(igimp::multigrid::DofGeometry::of_equations(&nodes, &dofs));
+        matrix.set_tolerance(1e-8);
+    }
     let pattern = t.elapsed().as_secs_f64();
     let f_ext = vec![1.0; dofs.len()];
     let (mut trials, mut du) = (Vec::new(), Vec::new());
@@ -106,9 +113,20 @@ pub fn time_iteration<const D: usize>(
     sys.matrix.solve_in_place(&mut r).unwrap(); // symbolic + numeric
     let first_solve = t.elapsed().as_secs_f64();
     let mut r2 = vec![1.0; dofs.len()];
+    let before = sys.matrix.stats();
     let t = Instant::now();
     sys.matrix.solve_in_place(&mut r2).unwrap(); // numeric only (symbolic cached)
     let solve = t.elapsed().as_secs_f64();
+    let after = sys.matrix.stats();
+    if solver == LinearSolver::Cg {
+        println!(
+            "  CG: {} iterations, multigrid set-up {:.3} s, iterations {:.3} s, {} fallbacks",
+            after.iterations - before.iterations,
+            after.setup_seconds - before.setup_seconds,
+            after.solve_seconds - before.solve_seconds,
+            sys.matrix.fallbacks()
+        );
+    }
     println!(
         "{D}D {:>9} points, h = 1/{:<3} {:>8} dofs, nnz {:>10}, {:?}, ghost {} faces: setup {setup:.3} s | per iteration: weights {weights:.3} s, \
          ghost faces+fill {ghost_build:.3} s, constitutive+residual {constitutive:.3} s, tangent assembly {tangent:.3} s, factorisation+solve {solve:.3} s \

@@ -242,10 +242,25 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
     pub fn linear_solver_fallbacks(&self) -> usize {
         self.core.work.matrix.fallbacks()
     }
+
+    /// What the linear solves have cost so far (solves, CG iterations, seconds).
+    pub fn linear_stats(&self) -> crate::linear::LinearStats {
+        self.core.work.matrix.stats()
+    }
+
+    /// Unknowns and non-zeros of the last tangent.
+    pub fn system_size(&self) -> (usize, usize) {
+        (self.core.work.matrix.dim(), self.core.work.matrix.nnz())
+    }
 }
 
 impl<const D: usize, E: ElementFamily<D>> LoadStepping for ContinuumFem<D, E> {
     fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
+        // The multigrid coarsens the initial (structured) mesh: its nodes nest in the coarse
+        // grids, which the deformed ones need not.
+        if self.settings.linear_solver == LinearSolver::Cg && self.core.work.node_geometry.is_none() {
+            self.core.work.node_geometry = Some(crate::multigrid::NodeGeometry::of_mesh(&self.mesh0));
+        }
         fem_advance(
             &mut self.core,
             &mut self.mesh,

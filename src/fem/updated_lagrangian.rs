@@ -112,7 +112,10 @@ impl<const D: usize> UlCore<D> {
             model,
             fixed_dofs,
             step: 0,
-            work: StepWorkspace::default(),
+            work: StepWorkspace {
+                fixed_pattern: true,
+                ..StepWorkspace::default()
+            },
         }
     }
 

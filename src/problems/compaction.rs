@@ -300,13 +300,23 @@ pub struct FemOutcome {
 /// paper's Figure 17 reference) or Q8 with 3×3 (a comparison for plastic flow, where Q4
 /// locks). LDLᵀ solves.
 pub fn solve_fem(spec: &CompactionSpec, element: QuadElement) -> Result<FemOutcome, InputError> {
+    let (fem, corner) = fem_solver(spec, element)?;
+    Ok(run_fem_block(fem, corner))
+}
+
+/// The plane-strain FEM solver of `spec` with `element` (Q4 or Q8 on the modelled half block,
+/// h = `element_size`), undeformed, and the node whose u_x is Figure 17's measure.
+pub fn fem_solver(
+    spec: &CompactionSpec,
+    element: QuadElement,
+) -> Result<(crate::fem::PlaneFem, usize), InputError> {
     let h = spec.element_size;
     let cells = [
         (spec.half_width / h).round() as usize,
         (spec.height / h).round() as usize,
     ];
     let size = SVector::<f64, 2>::new(spec.half_width, spec.height);
-    solve_fem_block(
+    fem_block(
         spec,
         PlaneMesh::structured(SVector::zeros(), size, cells, element)?,
     )
@@ -315,11 +325,12 @@ pub fn solve_fem(spec: &CompactionSpec, element: QuadElement) -> Result<FemOutco
 /// The FEM block of either dimension on `mesh` (the modelled part, from the origin): rollers
 /// on every coordinate plane through the origin (the symmetry planes and the base), gravity
 /// along the last axis, the element's default Gauss rule (2 per axis for Q4/Hex8, 3 for
-/// Q8/Hex20), LDLᵀ. The measure is u_x of the node at (half_width, 0, …).
-fn solve_fem_block<const D: usize, E: ElementFamily<D>>(
+/// Q8/Hex20), LDLᵀ (or the spec's iterative solver). Returns the solver and the node at
+/// (half_width, 0, …), whose u_x is the measure.
+fn fem_block<const D: usize, E: ElementFamily<D>>(
     spec: &CompactionSpec,
     mesh: ElementMesh<D, E>,
-) -> Result<FemOutcome, InputError> {
+) -> Result<(ContinuumFem<D, E>, usize), InputError> {
     let tol = 1e-9 * spec.element_size;
     let mut fixed: Vec<(usize, usize)> = vec![];
     for axis in 0..D {
@@ -328,7 +339,6 @@ fn solve_fem_block<const D: usize, E: ElementFamily<D>>(
     let mut corner = SVector::<f64, D>::zeros();
     corner[0] = spec.half_width;
     let corner = mesh.nearest_node(corner);
-    let elements = mesh.num_elements();
     let mut gravity = SVector::<f64, D>::zeros();
     gravity[D - 1] = -spec.unit_weight();
     let loads = FemLoads {
@@ -339,19 +349,43 @@ fn solve_fem_block<const D: usize, E: ElementFamily<D>>(
         gauss_points: None,
         newton: spec.newton,
         load_steps: spec.load_steps,
-        linear_solver: LinearSolver::Ldlt,
+        // LDLᵀ unless the spec asks for the iterative solver (its LU default is the material
+        // point methods').
+        linear_solver: if spec.linear_solver == LinearSolver::Cg {
+            LinearSolver::Cg
+        } else {
+            LinearSolver::Ldlt
+        },
     };
-    let mut fem = ContinuumFem::try_new(mesh, 1.0, spec.model()?, fixed, loads, settings)?;
+    let fem = ContinuumFem::try_new(mesh, 1.0, spec.model()?, fixed, loads, settings)?;
+    Ok((fem, corner))
+}
+
+/// Run the FEM block of [`fem_block`] to the end.
+fn solve_fem_block<const D: usize, E: ElementFamily<D>>(
+    spec: &CompactionSpec,
+    mesh: ElementMesh<D, E>,
+) -> Result<FemOutcome, InputError> {
+    let (fem, corner) = fem_block(spec, mesh)?;
+    Ok(run_fem_block(fem, corner))
+}
+
+/// All load steps of an FEM block; the measure is u_x of `corner`.
+fn run_fem_block<const D: usize, E: ElementFamily<D>>(
+    mut fem: ContinuumFem<D, E>,
+    corner: usize,
+) -> FemOutcome {
+    let elements = fem.mesh.num_elements();
     let (steps, failure) = match fem.run() {
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
     };
-    Ok(FemOutcome {
+    FemOutcome {
         steps,
         failure,
         max_horizontal_displacement: fem.displacement(corner)[0],
         elements,
-    })
+    }
 }
 
 /// The methods that solve the plane-strain compaction.

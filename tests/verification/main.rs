@@ -14,6 +14,7 @@ mod fem2d;
 mod fem3d;
 mod hostile;
 mod manufactured;
+mod multigrid;
 mod patch;
 mod plasticity;
 mod robustness;

@@ -1,0 +1,591 @@
+//! Geometric multigrid on the structured background grid (or FEM mesh), as the preconditioner
+//! of a conjugate-gradient solve of the Newton systems ([`crate::linear::LinearSolver::Cg`]).
+//!
+//! The grids of this code are structured, which is where multigrid is optimal: each coarse
+//! level is the grid of twice the spacing, and the prolongation P interpolates every
+//! displacement component multilinearly from the coarse grid's nodes to the fine level's
+//! dofs, located at their nodes. Partially filled cells, fixed and tied dofs need no special
+//! case: P maps to the free equations only (a fixed dof is not a row of P), and a coarse dof
+//! exists where some fine equation draws on it. The coarse operators are Galerkin products
+//! A_{l+1} = Pᵀ A_l P, so the ghost penalty, the contact of slivers and the material tangent
+//! all pass to the coarse levels; the coarsest (at most [`COARSE_SIZE`] equations) is
+//! factorised directly. Smoothing is Chebyshev on D⁻¹A (degree [`CHEBYSHEV_DEGREE`]; the
+//! same polynomial before and after the coarse correction, so the V-cycle is a symmetric
+//! preconditioner and CG applies).
+//!
+//! The hierarchy needs no symbolic analysis: P depends only on where the equations sit, and
+//! the Galerkin products are computed with a sparse accumulator.
+//!
+//! # References
+//! Trottenberg, Oosterlee & Schüller, *Multigrid* (2001), ch. 2 and 7 (Galerkin coarse
+//! operators); Adams, Brezina, Hu & Tuminaro, "Parallel multigrid smoothing: polynomial
+//! versus Gauss–Seidel", J. Comput. Phys. 188 (2003) (Chebyshev smoothers, eigenvalue
+//! bounds); Saad, *Iterative Methods for Sparse Linear Systems* (2003), alg. 6.18 (PCG) and
+//! alg. 12.1 (Chebyshev).
+
+use crate::linear::{LinearSolver, SparseSystem};
+use rayon::prelude::*;
+
+/// The coarsest level is solved directly once it has at most this many equations.
+pub const COARSE_SIZE: usize = 2_000;
+/// Degree of the Chebyshev smoother (matrix–vector products per smoothing).
+pub const CHEBYSHEV_DEGREE: usize = 3;
+/// Chebyshev smooths the eigenvalues of D⁻¹A in [λ_max / `CHEBYSHEV_RATIO`, 1.1 λ_max].
+pub const CHEBYSHEV_RATIO: f64 = 10.0;
+/// Most levels (a grid of 2^20 cells per axis has 21).
+pub const MAX_LEVELS: usize = 24;
+/// Rows per parallel task of the sparse kernels.
+const CHUNK: usize = 4096;
+
+/// Where each equation sits: the position of its node (padded to three components) and the
+/// displacement component it carries; `spacing` is the fine grid's (or mesh's element) size
+/// per axis, `dim` the problem's dimension.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct DofGeometry {
+    pub dim: usize,
+    pub spacing: [f64; 3],
+    pub positions: Vec<[f64; 3]>,
+    pub components: Vec<u8>,
+}
+
+/// Where the nodes of a discretisation sit (padded to three components) and its fine spacing
+/// per axis: what a solver hands its workspace so that the equations can be located
+/// ([`DofGeometry::of_equations`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct NodeGeometry {
+    pub dim: usize,
+    pub positions: Vec<[f64; 3]>,
+    pub spacing: [f64; 3],
+}
+
+impl NodeGeometry {
+    /// The nodes of a background grid.
+    pub fn of_grid<const D: usize>(grid: &crate::grid::Grid<D>) -> Self {
+        let h = grid.spacing();
+        NodeGeometry {
+            dim: D,
+            positions: (0..grid.num_nodes())
+                .map(|n| crate::vtk::pad3(&grid.node_position(n)))
+                .collect(),
+            spacing: std::array::from_fn(|a| if a < D { h[a] } else { 1.0 }),
+        }
+    }
+
+    /// The nodes of an FEM mesh; the spacing is that of the first element's nodes (its
+    /// extent per axis, halved for quadratic elements, whose mid-edge nodes halve it).
+    pub fn of_mesh<const D: usize, E: crate::fem::ElementFamily<D>>(
+        mesh: &crate::fem::ElementMesh<D, E>,
+    ) -> Self {
+        let mut spacing = [1.0; 3];
+        if mesh.num_elements() > 0 {
+            let nodes = mesh.element_nodes(0);
+            for (a, h) in spacing.iter_mut().enumerate().take(D) {
+                let (lo, hi) = nodes
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &n| {
+                        (lo.min(mesh.nodes[n][a]), hi.max(mesh.nodes[n][a]))
+                    });
+                *h = (hi - lo) / if mesh.element.quadratic() { 2.0 } else { 1.0 };
+            }
+        }
+        NodeGeometry {
+            dim: D,
+            positions: mesh.nodes.iter().map(crate::vtk::pad3).collect(),
+            spacing,
+        }
+    }
+}
+
+impl DofGeometry {
+    /// The position and component of every equation of `dofs` (a tied dof sits at its
+    /// master, the first node numbered with the equation).
+    pub fn of_equations(nodes: &NodeGeometry, dofs: &crate::dofs::DofMap) -> Self {
+        let d = nodes.dim;
+        let mut out = DofGeometry {
+            dim: d,
+            spacing: nodes.spacing,
+            positions: vec![[f64::NAN; 3]; dofs.len()],
+            components: vec![0; dofs.len()],
+        };
+        for dof in 0..dofs.num_dofs() {
+            if let Some(e) = dofs.eq(dof) {
+                if out.positions[e][0].is_nan() {
+                    out.positions[e] = nodes.positions[dof / d];
+                    out.components[e] = (dof % d) as u8;
+                }
+            }
+        }
+        out
+    }
+}
+
+/// A sparse matrix in compressed sparse row form.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Csr {
+    pub rows: usize,
+    pub cols: usize,
+    pub ptr: Vec<usize>,
+    pub idx: Vec<usize>,
+    pub val: Vec<f64>,
+}
+
+impl Csr {
+    pub fn nnz(&self) -> usize {
+        self.idx.len()
+    }
+
+    /// `y = A x`, rows in parallel.
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        y.par_chunks_mut(CHUNK).enumerate().for_each(|(c, ys)| {
+            let first = c * CHUNK;
+            for (k, yi) in ys.iter_mut().enumerate() {
+                let i = first + k;
+                let mut s = 0.0;
+                for j in self.ptr[i]..self.ptr[i + 1] {
+                    s += self.val[j] * x[self.idx[j]];
+                }
+                *yi = s;
+            }
+        });
+    }
+
+    /// `r = b − A x`.
+    fn residual(&self, b: &[f64], x: &[f64], r: &mut [f64]) {
+        r.par_chunks_mut(CHUNK).enumerate().for_each(|(c, rs)| {
+            let first = c * CHUNK;
+            for (k, ri) in rs.iter_mut().enumerate() {
+                let i = first + k;
+                let mut s = b[i];
+                for j in self.ptr[i]..self.ptr[i + 1] {
+                    s -= self.val[j] * x[self.idx[j]];
+                }
+                *ri = s;
+            }
+        });
+    }
+
+    pub fn diagonal(&self) -> Vec<f64> {
+        (0..self.rows)
+            .map(|i| {
+                (self.ptr[i]..self.ptr[i + 1])
+                    .find(|&j| self.idx[j] == i)
+                    .map_or(0.0, |j| self.val[j])
+            })
+            .collect()
+    }
+
+    pub fn transpose(&self) -> Csr {
+        let mut count = vec![0usize; self.cols + 1];
+        for &j in &self.idx {
+            count[j + 1] += 1;
+        }
+        for j in 0..self.cols {
+            count[j + 1] += count[j];
+        }
+        let ptr = count.clone();
+        let mut next = count;
+        let mut idx = vec![0; self.nnz()];
+        let mut val = vec![0.0; self.nnz()];
+        for i in 0..self.rows {
+            for k in self.ptr[i]..self.ptr[i + 1] {
+                let j = self.idx[k];
+                idx[next[j]] = i;
+                val[next[j]] = self.val[k];
+                next[j] += 1;
+            }
+        }
+        Csr {
+            rows: self.cols,
+            cols: self.rows,
+            ptr,
+            idx,
+            val,
+        }
+    }
+
+    /// `A B` (Gustavson's row-by-row product with a dense accumulator per task; column
+    /// indices of each row sorted, so the result does not depend on the thread count).
+    pub fn matmul(&self, b: &Csr) -> Csr {
+        assert_eq!(self.cols, b.rows, "matmul: inner dimensions");
+        let chunks: Vec<(Vec<usize>, Vec<usize>, Vec<f64>)> = (0..self.rows.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let rows = c * CHUNK..((c + 1) * CHUNK).min(self.rows);
+                let mut acc = vec![0.0; b.cols];
+                let mut seen = vec![false; b.cols];
+                let mut cols: Vec<usize> = vec![];
+                let (mut len, mut idx, mut val) = (vec![], vec![], vec![]);
+                for i in rows {
+                    cols.clear();
+                    for k in self.ptr[i]..self.ptr[i + 1] {
+                        let (j, a) = (self.idx[k], self.val[k]);
+                        for m in b.ptr[j]..b.ptr[j + 1] {
+                            let col = b.idx[m];
+                            if !seen[col] {
+                                seen[col] = true;
+                                cols.push(col);
+                            }
+                            acc[col] += a * b.val[m];
+                        }
+                    }
+                    cols.sort_unstable();
+                    len.push(cols.len());
+                    for &col in &cols {
+                        idx.push(col);
+                        val.push(acc[col]);
+                        acc[col] = 0.0;
+                        seen[col] = false;
+                    }
+                }
+                (len, idx, val)
+            })
+            .collect();
+        let mut out = Csr {
+            rows: self.rows,
+            cols: b.cols,
+            ptr: Vec::with_capacity(self.rows + 1),
+            idx: vec![],
+            val: vec![],
+        };
+        out.ptr.push(0);
+        for (len, idx, val) in chunks {
+            for l in len {
+                out.ptr.push(out.ptr.last().unwrap() + l);
+            }
+            out.idx.extend(idx);
+            out.val.extend(val);
+        }
+        out
+    }
+}
+
+/// The prolongation from the grid of spacing `coarse` (origin `origin`) to the equations of
+/// `fine`: row i interpolates component `components[i]` multilinearly from the 2^dim coarse
+/// nodes around `positions[i]`; weights below 1e-12 are dropped. Returns P and the coarse
+/// level's geometry (its equations numbered in order of first use, so deterministically).
+pub fn prolongation(fine: &DofGeometry, origin: [f64; 3], coarse: [f64; 3]) -> (Csr, DofGeometry) {
+    let dim = fine.dim;
+    // The coarse nodes that can be touched: a box of node indices around the fine positions.
+    let mut hi = [0i64; 3];
+    for x in &fine.positions {
+        for a in 0..dim {
+            hi[a] = hi[a].max(((x[a] - origin[a]) / coarse[a]).floor() as i64 + 1);
+        }
+    }
+    let extent: [usize; 3] = std::array::from_fn(|a| if a < dim { (hi[a] + 1) as usize } else { 1 });
+    let nodes = extent[0] * extent[1] * extent[2];
+    let mut number = vec![usize::MAX; nodes * dim];
+    let mut out = DofGeometry {
+        dim,
+        spacing: coarse,
+        positions: vec![],
+        components: vec![],
+    };
+    let mut p = Csr {
+        rows: fine.positions.len(),
+        cols: 0,
+        ptr: Vec::with_capacity(fine.positions.len() + 1),
+        idx: vec![],
+        val: vec![],
+    };
+    p.ptr.push(0);
+    for (x, &c) in fine.positions.iter().zip(&fine.components) {
+        let mut cell = [0usize; 3];
+        let mut t = [0.0; 3];
+        for a in 0..dim {
+            let s = ((x[a] - origin[a]) / coarse[a]).max(0.0);
+            let k = (s.floor() as usize).min(extent[a].saturating_sub(2));
+            cell[a] = k;
+            t[a] = (s - k as f64).clamp(0.0, 1.0);
+        }
+        let start = p.idx.len();
+        for corner in 0..1usize << dim {
+            let mut w = 1.0;
+            let mut node = [0usize; 3];
+            for a in 0..dim {
+                let up = (corner >> a) & 1 == 1;
+                node[a] = cell[a] + up as usize;
+                w *= if up { t[a] } else { 1.0 - t[a] };
+            }
+            if w.abs() < 1e-12 {
+                continue;
+            }
+            let flat = (node[2] * extent[1] + node[1]) * extent[0] + node[0];
+            let slot = &mut number[flat * dim + c as usize];
+            if *slot == usize::MAX {
+                *slot = out.positions.len();
+                out.positions.push(std::array::from_fn(|a| {
+                    if a < dim {
+                        origin[a] + node[a] as f64 * coarse[a]
+                    } else {
+                        0.0
+                    }
+                }));
+                out.components.push(c);
+            }
+            p.idx.push(*slot);
+            p.val.push(w);
+        }
+        // Sorted columns per row (the accumulator products expect nothing more).
+        let (idx, val) = (&mut p.idx[start..], &mut p.val[start..]);
+        let mut pairs: Vec<(usize, f64)> = idx.iter().copied().zip(val.iter().copied()).collect();
+        pairs.sort_unstable_by_key(|e| e.0);
+        for (k, (i, v)) in pairs.into_iter().enumerate() {
+            idx[k] = i;
+            val[k] = v;
+        }
+        p.ptr.push(p.idx.len());
+    }
+    p.cols = out.positions.len();
+    (p, out)
+}
+
+/// One level of the hierarchy: its operator, the prolongation from the next coarser level,
+/// the inverse diagonal and the Chebyshev interval.
+#[derive(Debug, Clone)]
+struct Level {
+    a: Csr,
+    p: Csr,
+    r: Csr,
+    inv_diag: Vec<f64>,
+    /// Chebyshev interval of D⁻¹A.
+    bounds: (f64, f64),
+}
+
+/// A multigrid V-cycle for one matrix.
+#[derive(Debug)]
+pub struct Hierarchy {
+    levels: Vec<Level>,
+    coarse: SparseSystem,
+    /// Equations per level, finest first (the coarsest last).
+    pub sizes: Vec<usize>,
+    /// Non-zeros per level, finest first.
+    pub nnz: Vec<usize>,
+}
+
+/// The largest eigenvalue of D⁻¹A by the power method (20 iterations from a fixed start,
+/// so the result is deterministic); an estimate from below, hence the 1.1 margin of the
+/// Chebyshev interval.
+fn lambda_max(a: &Csr, inv_diag: &[f64]) -> f64 {
+    let n = a.rows;
+    let mut x: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 17) as f64 / 17.0).collect();
+    let mut y = vec![0.0; n];
+    let mut lambda = 0.0;
+    for _ in 0..20 {
+        let nx = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if nx == 0.0 {
+            break;
+        }
+        x.iter_mut().for_each(|v| *v /= nx);
+        a.mul_vec(&x, &mut y);
+        y.iter_mut().zip(inv_diag).for_each(|(v, d)| *v *= d);
+        lambda = x.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>();
+        std::mem::swap(&mut x, &mut y);
+    }
+    lambda.abs()
+}
+
+impl Hierarchy {
+    /// The hierarchy of `a` (symmetric, the equations of `geometry`): coarse levels of twice
+    /// the spacing until at most [`COARSE_SIZE`] equations remain or a level stops shrinking.
+    pub fn build(a: Csr, geometry: &DofGeometry) -> Result<Self, String> {
+        if geometry.positions.len() != a.rows || geometry.components.len() != a.rows {
+            return Err(format!(
+                "multigrid: {} equations but geometry for {}",
+                a.rows,
+                geometry.positions.len()
+            ));
+        }
+        let mut origin = [0.0; 3];
+        for a_ in 0..geometry.dim {
+            origin[a_] = geometry
+                .positions
+                .iter()
+                .map(|x| x[a_])
+                .fold(f64::INFINITY, f64::min);
+        }
+        let mut levels: Vec<Level> = vec![];
+        let mut geo = geometry.clone();
+        let mut a = a;
+        let mut spacing = geometry.spacing;
+        while a.rows > COARSE_SIZE && levels.len() < MAX_LEVELS {
+            spacing.iter_mut().for_each(|h| *h *= 2.0);
+            let (p, coarse_geo) = prolongation(&geo, origin, spacing);
+            if p.cols * 10 > a.rows * 9 {
+                // Not shrinking (e.g. a grid one cell thick along every coarsened axis).
+                break;
+            }
+            let r = p.transpose();
+            let coarse = r.matmul(&a.matmul(&p));
+            let diag = a.diagonal();
+            if let Some(i) = diag.iter().position(|&d| !(d > 0.0 && d.is_finite())) {
+                return Err(format!(
+                    "multigrid: diagonal entry {i} is {} (not positive)",
+                    diag[i]
+                ));
+            }
+            let inv_diag: Vec<f64> = diag.iter().map(|d| 1.0 / d).collect();
+            let lmax = 1.1 * lambda_max(&a, &inv_diag);
+            levels.push(Level {
+                a,
+                p,
+                r,
+                inv_diag,
+                bounds: (lmax / CHEBYSHEV_RATIO, lmax),
+            });
+            a = coarse;
+            geo = coarse_geo;
+        }
+        let mut sizes: Vec<usize> = levels.iter().map(|l| l.a.rows).collect();
+        let mut nnz: Vec<usize> = levels.iter().map(|l| l.a.nnz()).collect();
+        sizes.push(a.rows);
+        nnz.push(a.nnz());
+        // The coarsest operator, factorised directly (its CSR is the CSC of its transpose,
+        // the same matrix since it is symmetric).
+        let mut coarse = SparseSystem::default();
+        coarse.set_solver(LinearSolver::Ldlt);
+        let columns: Vec<Vec<usize>> = (0..a.rows)
+            .map(|i| a.idx[a.ptr[i]..a.ptr[i + 1]].to_vec())
+            .collect();
+        coarse.set_pattern(columns);
+        for i in 0..a.rows {
+            for k in a.ptr[i]..a.ptr[i + 1] {
+                coarse.add(a.idx[k], i, a.val[k]);
+            }
+        }
+        coarse.factorize()?;
+        Ok(Hierarchy {
+            levels,
+            coarse,
+            sizes,
+            nnz,
+        })
+    }
+
+    /// `x = M⁻¹ b`: one V-cycle from a zero guess.
+    pub fn apply(&mut self, b: &[f64], x: &mut [f64]) -> Result<(), String> {
+        self.cycle(0, b, x)
+    }
+
+    fn cycle(&mut self, l: usize, b: &[f64], x: &mut [f64]) -> Result<(), String> {
+        if l == self.levels.len() {
+            x.copy_from_slice(b);
+            return self.coarse.solve_factorized(x);
+        }
+        x.iter_mut().for_each(|v| *v = 0.0);
+        let n = b.len();
+        let mut r = vec![0.0; n];
+        let mut d = vec![0.0; n];
+        chebyshev(&self.levels[l], b, x, &mut r, &mut d);
+        let lv = &self.levels[l];
+        lv.a.residual(b, x, &mut r);
+        let mut bc = vec![0.0; lv.p.cols];
+        lv.r.mul_vec(&r, &mut bc);
+        let mut xc = vec![0.0; bc.len()];
+        self.cycle(l + 1, &bc, &mut xc)?;
+        let lv = &self.levels[l];
+        lv.p.mul_vec(&xc, &mut r);
+        x.par_iter_mut().zip(&r).for_each(|(xi, ei)| *xi += ei);
+        chebyshev(lv, b, x, &mut r, &mut d);
+        Ok(())
+    }
+}
+
+/// [`CHEBYSHEV_DEGREE`] Chebyshev iterations on A x = b preconditioned by D⁻¹ over the
+/// level's interval (Saad alg. 12.1); `r`, `d` are work vectors.
+fn chebyshev(lv: &Level, b: &[f64], x: &mut [f64], r: &mut [f64], d: &mut [f64]) {
+    let (lo, hi) = lv.bounds;
+    let theta = 0.5 * (hi + lo);
+    let delta = 0.5 * (hi - lo);
+    let sigma = theta / delta;
+    let mut rho = 1.0 / sigma;
+    lv.a.residual(b, x, r);
+    d.par_iter_mut()
+        .zip(r.par_iter())
+        .zip(lv.inv_diag.par_iter())
+        .for_each(|((di, ri), w)| *di = ri * w / theta);
+    for k in 0..CHEBYSHEV_DEGREE {
+        x.par_iter_mut().zip(d.par_iter()).for_each(|(xi, di)| *xi += di);
+        if k + 1 == CHEBYSHEV_DEGREE {
+            break;
+        }
+        lv.a.residual(b, x, r);
+        let rho_new = 1.0 / (2.0 * sigma - rho);
+        let (c1, c2) = (rho_new * rho, 2.0 * rho_new / delta);
+        d.par_iter_mut()
+            .zip(r.par_iter())
+            .zip(lv.inv_diag.par_iter())
+            .for_each(|((di, ri), w)| *di = c1 * *di + c2 * ri * w);
+        rho = rho_new;
+    }
+}
+
+/// What a preconditioned conjugate-gradient solve did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CgReport {
+    pub iterations: usize,
+    /// ‖b − A x‖ / ‖b‖ at the end.
+    pub relative_residual: f64,
+}
+
+/// Solve `A x = b` by CG preconditioned with `m`, from x = 0, until ‖b − A x‖ ≤ `rtol` ‖b‖
+/// (Saad alg. 6.18). An error if `max_iterations` pass first or the iteration breaks down
+/// (A or M not positive definite along the search direction).
+pub fn pcg(
+    a: &Csr,
+    m: &mut Hierarchy,
+    b: &[f64],
+    x: &mut [f64],
+    rtol: f64,
+    max_iterations: usize,
+) -> Result<CgReport, String> {
+    let n = b.len();
+    let dot = |u: &[f64], v: &[f64]| -> f64 { u.par_iter().zip(v.par_iter()).map(|(a, b)| a * b).sum() };
+    x.iter_mut().for_each(|v| *v = 0.0);
+    let bnorm = dot(b, b).sqrt();
+    if bnorm == 0.0 {
+        return Ok(CgReport {
+            iterations: 0,
+            relative_residual: 0.0,
+        });
+    }
+    let mut r = b.to_vec();
+    let mut z = vec![0.0; n];
+    m.apply(&r, &mut z)?;
+    let mut p = z.clone();
+    let mut q = vec![0.0; n];
+    let mut rz = dot(&r, &z);
+    for it in 1..=max_iterations {
+        a.mul_vec(&p, &mut q);
+        let pq = dot(&p, &q);
+        if !(pq > 0.0 && rz > 0.0) {
+            return Err(format!(
+                "CG broke down at iteration {it} (pᵀAp = {pq:e}, rᵀz = {rz:e}): the tangent or the preconditioner is not positive definite"
+            ));
+        }
+        let alpha = rz / pq;
+        x.par_iter_mut()
+            .zip(p.par_iter())
+            .for_each(|(xi, pi)| *xi += alpha * pi);
+        r.par_iter_mut()
+            .zip(q.par_iter())
+            .for_each(|(ri, qi)| *ri -= alpha * qi);
+        let rel = dot(&r, &r).sqrt() / bnorm;
+        if rel <= rtol {
+            return Ok(CgReport {
+                iterations: it,
+                relative_residual: rel,
+            });
+        }
+        m.apply(&r, &mut z)?;
+        let rz_new = dot(&r, &z);
+        let beta = rz_new / rz;
+        rz = rz_new;
+        p.par_iter_mut()
+            .zip(z.par_iter())
+            .for_each(|(pi, zi)| *pi = zi + beta * *pi);
+    }
+    Err(format!(
+        "CG did not reach the relative residual {rtol:e} in {max_iterations} iterations"
+    ))
+}
