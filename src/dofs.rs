@@ -183,29 +183,69 @@ impl DofMap {
 
     /// Sparsity pattern (per column, the rows) coupling every pair of free dofs that share a point.
     ///
-    /// A point whose node list equals the previous point's adds nothing and is skipped: the
-    /// Gauss points of one element (and material points of one cell) come in runs, so this
-    /// divides the transient storage by the points per element on large meshes.
+    /// Built at the node level: the points touching each node (a node → points index), then
+    /// each node's neighbour nodes with a marker array, in parallel over blocks of nodes, and
+    /// only then expanded to the D × D dof couplings. A point couples up to 27 nodes in 3D,
+    /// i.e. 81 × 81 dof pairs: going through nodes first divides the transient work by D² and
+    /// needs no sorting of duplicated lists (measured 2026-12-02 on the 3D compaction at
+    /// 1,024,000 points: 7.5 s per step before).
     pub fn pattern<const D: usize>(&self, table: &SupportTable<D>) -> Vec<Vec<usize>> {
-        let mut columns: Vec<Vec<usize>> = vec![Vec::new(); self.count];
-        let mut eqs = Vec::with_capacity(MAX_POINT_NODES * D);
-        let mut previous: &[usize] = &[];
+        use rayon::prelude::*;
+        let num_nodes = self.eq.len() / D;
+        let has_eq = |n: usize| (0..D).any(|a| self.eq[n * D + a].is_some());
+        // node → points touching it, CSR.
+        let mut start = vec![0usize; num_nodes + 1];
         for p in 0..table.num_points() {
-            let (nodes, _, _) = table.point(p);
-            if nodes == previous {
-                continue;
+            for &n in table.point(p).0 {
+                start[n + 1] += 1;
             }
-            previous = nodes;
-            eqs.clear();
-            for &n in nodes {
-                for a in 0..D {
-                    if let Some(e) = self.eq[n * D + a] {
-                        eqs.push(e);
+        }
+        for n in 0..num_nodes {
+            start[n + 1] += start[n];
+        }
+        let mut next = start.clone();
+        let mut points = vec![0usize; start[num_nodes]];
+        for p in 0..table.num_points() {
+            for &n in table.point(p).0 {
+                points[next[n]] = p;
+                next[n] += 1;
+            }
+        }
+        // Neighbour nodes (with equations) of each node, sorted.
+        let blocks = (rayon::current_num_threads() * 8).max(1);
+        let block = num_nodes.div_ceil(blocks).max(1);
+        let neighbours: Vec<Vec<Vec<usize>>> = (0..num_nodes.div_ceil(block))
+            .into_par_iter()
+            .map(|b| {
+                let mut seen = vec![usize::MAX; num_nodes];
+                let mut out = vec![];
+                for n in b * block..((b + 1) * block).min(num_nodes) {
+                    let mut list = vec![];
+                    if has_eq(n) {
+                        for &p in &points[start[n]..start[n + 1]] {
+                            for &m in table.point(p).0 {
+                                if seen[m] != n && has_eq(m) {
+                                    seen[m] = n;
+                                    list.push(m);
+                                }
+                            }
+                        }
+                        list.sort_unstable();
                     }
+                    out.push(list);
                 }
-            }
-            for &c in &eqs {
-                columns[c].extend_from_slice(&eqs);
+                out
+            })
+            .collect();
+        let mut columns: Vec<Vec<usize>> = vec![Vec::new(); self.count];
+        for (n, list) in neighbours.into_iter().flatten().enumerate() {
+            for a in 0..D {
+                let Some(e) = self.eq[n * D + a] else { continue };
+                let col = &mut columns[e];
+                col.reserve(list.len() * D);
+                for &m in &list {
+                    col.extend((0..D).filter_map(|b| self.eq[m * D + b]));
+                }
             }
         }
         columns

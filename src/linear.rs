@@ -288,14 +288,7 @@ impl SparseSystem {
     /// The pattern and values as a row-compressed matrix (the transpose of the stored
     /// column-compressed one).
     pub fn to_csr(&self) -> crate::multigrid::Csr {
-        crate::multigrid::Csr {
-            rows: self.n,
-            cols: self.n,
-            ptr: self.col_ptr.clone(),
-            idx: self.row_idx.clone(),
-            val: self.values.clone(),
-        }
-        .transpose()
+        crate::multigrid::Csr::from_csc(self.n, &self.col_ptr, &self.row_idx, &self.values)
     }
 
     fn solve_cg(&mut self, rhs: &mut [f64]) -> Result<(), String> {
@@ -305,8 +298,7 @@ impl SparseSystem {
             .as_ref()
             .ok_or("the CG solver needs the equations' positions (SparseSystem::set_geometry)")?;
         let start = std::time::Instant::now();
-        let a = self.to_csr();
-        let mut m = Hierarchy::build(a.clone(), geometry)?;
+        let mut m = Hierarchy::build(self.to_csr(), geometry)?;
         self.stats.setup_seconds += start.elapsed().as_secs_f64();
         let start = std::time::Instant::now();
         let b = rhs.to_vec();
@@ -315,7 +307,7 @@ impl SparseSystem {
         } else {
             DEFAULT_ITERATIVE_TOLERANCE
         };
-        let report = pcg(&a, &mut m, &b, rhs, rtol, MAX_CG_ITERATIONS);
+        let report = pcg(&mut m, &b, rhs, rtol, MAX_CG_ITERATIONS);
         self.stats.solve_seconds += start.elapsed().as_secs_f64();
         self.stats.iterations += report.as_ref().map_or(MAX_CG_ITERATIONS, |r| r.iterations);
         report.map(|_| ())
