@@ -499,6 +499,16 @@ impl<const D: usize> StepWorkspace<D> {
         })
     }
 
+    /// The size of the last step's system and the CG iterations since `iterations_before`
+    /// (the matrix's count before the step's solves).
+    pub fn linear_record(&self, iterations_before: usize) -> crate::load_stepping::LinearRecord {
+        crate::load_stepping::LinearRecord {
+            unknowns: self.matrix.dim(),
+            nonzeros: self.matrix.nnz(),
+            iterations: self.matrix.stats().iterations - iterations_before,
+        }
+    }
+
     /// Committed states of the converged step.
     pub fn committed_states(&self) -> impl Iterator<Item = PointState> + '_ {
         self.trials

@@ -48,6 +48,9 @@ pub enum LinearSolver {
 pub const DEFAULT_ITERATIVE_TOLERANCE: f64 = 1e-10;
 /// Most CG iterations of one solve before it falls back to the direct solver.
 pub const MAX_CG_ITERATIONS: usize = 500;
+/// A kept multigrid is rebuilt once a solve needs more than this many times the iterations
+/// it took fresh (plus two).
+pub const REUSE_FACTOR: f64 = 1.5;
 
 /// What the linear solves of a system have cost so far (for the performance figures).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -61,6 +64,8 @@ pub struct LinearStats {
     pub solve_seconds: f64,
     /// Non-zeros of the last factor (direct solves).
     pub factor_nnz: usize,
+    /// Multigrid hierarchies rebuilt because a kept one had become ineffective.
+    pub rebuilds: usize,
 }
 
 /// A square sparse matrix in compressed sparse column form with cached symbolic
@@ -82,6 +87,9 @@ pub struct SparseSystem {
     /// Relative residual an iterative solve must reach (0: the default).
     tolerance: f64,
     stats: LinearStats,
+    /// The multigrid of an earlier matrix of this pattern and the CG iterations it took when
+    /// fresh ([`Self::solve_cg`] reuses it).
+    hierarchy: Option<(Box<crate::multigrid::Hierarchy>, usize)>,
 }
 
 /// A contiguous range of columns of a [`SparseSystem`] whose values one thread may update
@@ -179,6 +187,7 @@ impl SparseSystem {
         self.values.resize(self.row_idx.len(), 0.0);
         self.symbolic = None;
         self.symbolic_cholesky = None;
+        self.hierarchy = None;
     }
 
     /// Choose the factorisation (kept across [`Self::set_pattern`]).
@@ -200,6 +209,7 @@ impl SparseSystem {
     /// [`LinearSolver::Cg`] (kept until the next [`Self::set_geometry`]).
     pub fn set_geometry(&mut self, geometry: crate::multigrid::DofGeometry) {
         self.geometry = Some(geometry);
+        self.hierarchy = None;
     }
 
     /// The relative residual ‖b − K x‖ / ‖b‖ an iterative solve must reach (the Newton
@@ -291,26 +301,50 @@ impl SparseSystem {
         crate::multigrid::Csr::from_csc(self.n, &self.col_ptr, &self.row_idx, &self.values)
     }
 
+    /// CG with the multigrid of the pattern's last fresh build while it stays effective:
+    /// the hierarchy (Galerkin products, eigenvalue estimates) is rebuilt from the current
+    /// matrix when none exists for this pattern, or when a solve with the kept one needs more
+    /// than [`REUSE_FACTOR`] times the iterations it took fresh (plus two), or fails; that
+    /// solve is then repeated with the fresh hierarchy. Reuse changes the preconditioner, not
+    /// the system: every solve still reaches its tolerance on the current matrix.
     fn solve_cg(&mut self, rhs: &mut [f64]) -> Result<(), String> {
         use crate::multigrid::{pcg, Hierarchy};
-        let geometry = self
-            .geometry
-            .as_ref()
-            .ok_or("the CG solver needs the equations' positions (SparseSystem::set_geometry)")?;
-        let start = std::time::Instant::now();
-        let mut m = Hierarchy::build(self.to_csr(), geometry)?;
-        self.stats.setup_seconds += start.elapsed().as_secs_f64();
-        let start = std::time::Instant::now();
         let b = rhs.to_vec();
         let rtol = if self.tolerance > 0.0 {
             self.tolerance
         } else {
             DEFAULT_ITERATIVE_TOLERANCE
         };
-        let report = pcg(&mut m, &b, rhs, rtol, MAX_CG_ITERATIONS);
+        let start = std::time::Instant::now();
+        let a = self.to_csr();
+        self.stats.setup_seconds += start.elapsed().as_secs_f64();
+        if let Some((m, fresh)) = self.hierarchy.as_ref() {
+            // Given up once it needs more than the fresh count allows.
+            let allowed = (REUSE_FACTOR * *fresh as f64) as usize + 2;
+            let start = std::time::Instant::now();
+            let report = pcg(&a, m, &b, rhs, rtol, allowed);
+            self.stats.solve_seconds += start.elapsed().as_secs_f64();
+            self.stats.iterations += report.as_ref().map_or(allowed, |r| r.iterations);
+            match report {
+                Ok(_) => return Ok(()),
+                Err(_) => self.stats.rebuilds += 1,
+            }
+        }
+        let geometry = self
+            .geometry
+            .as_ref()
+            .ok_or("the CG solver needs the equations' positions (SparseSystem::set_geometry)")?;
+        let start = std::time::Instant::now();
+        self.hierarchy = None;
+        let m = Hierarchy::build(&a, geometry)?;
+        self.stats.setup_seconds += start.elapsed().as_secs_f64();
+        let start = std::time::Instant::now();
+        let report = pcg(&a, &m, &b, rhs, rtol, MAX_CG_ITERATIONS);
         self.stats.solve_seconds += start.elapsed().as_secs_f64();
         self.stats.iterations += report.as_ref().map_or(MAX_CG_ITERATIONS, |r| r.iterations);
-        report.map(|_| ())
+        let report = report?;
+        self.hierarchy = Some((Box::new(m), report.iterations));
+        Ok(())
     }
 
     /// Factorise (symmetric solvers: LDLᵀ or LLᵀ) for later [`Self::solve_factorized`].

@@ -31,6 +31,9 @@ pub struct StepReport {
     /// Grid nodes constrained by the weak-node treatment in this step (0 for FEM).
     #[serde(default)]
     pub weak_nodes: usize,
+    /// The size of the step's linear systems and the iterations of its iterative solves.
+    #[serde(default)]
+    pub linear: LinearRecord,
     /// Every attempt of a step that needed cutbacks, in order (empty when the nominal
     /// increment converged at once).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -44,12 +47,22 @@ impl StepReport {
     }
 }
 
+/// The linear systems of one converged increment: unknowns and non-zeros of its tangent and
+/// the CG iterations of its solves (0 for direct solves).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LinearRecord {
+    pub unknowns: usize,
+    pub nonzeros: usize,
+    pub iterations: usize,
+}
+
 /// One converged increment, as a solver reports it to the load stepping.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Increment {
     pub newton: NewtonReport,
     /// Grid nodes constrained by the weak-node treatment (0 for FEM).
     pub weak_nodes: usize,
+    pub linear: LinearRecord,
 }
 
 /// A solver that advances through proportional load steps, cutting a failing increment
@@ -111,6 +124,7 @@ pub trait LoadStepping {
                             load_factor: target,
                             newton: inc.newton,
                             weak_nodes: inc.weak_nodes,
+                            linear: inc.linear,
                             substeps,
                         });
                     }

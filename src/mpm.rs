@@ -470,11 +470,14 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
         }
         let input = step_input!(self, step);
         self.work.matrix.set_solver(self.settings.linear_solver);
+        let before = self.work.matrix.stats().iterations;
         let report = self.work.solve(&input, &self.settings.newton)?;
+        let linear = self.work.linear_record(before);
         self.commit().map_err(|f| (f, report.residuals.clone()))?;
         Ok(Increment {
             newton: report,
             weak_nodes: step.weak_nodes,
+            linear,
         })
     }
     fn steps_done(&self) -> usize {

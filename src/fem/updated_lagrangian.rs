@@ -168,6 +168,7 @@ impl<const D: usize> UlCore<D> {
         build_supports: impl FnOnce(&mut SupportTable<D>) -> Result<(), StepFailure>,
     ) -> Result<Increment, (StepFailure, Vec<f64>)> {
         build_supports(&mut self.work.table).map_err(|f| (f, vec![]))?;
+        let before = self.work.matrix.stats().iterations;
         let report = self.with_input(states, num_nodes, loads, load_factor, |work, input| {
             work.solve(input, newton)
         })?;
@@ -177,6 +178,7 @@ impl<const D: usize> UlCore<D> {
         Ok(Increment {
             newton: report,
             weak_nodes: 0,
+            linear: self.work.linear_record(before),
         })
     }
 }

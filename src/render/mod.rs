@@ -9,7 +9,7 @@ pub mod compaction;
 pub mod manufactured;
 
 use crate::study::checks::{check_counts, CheckRecord, GciRecord};
-use crate::study::results::{write_text, CaseStatus, FailureRecord};
+use crate::study::results::{write_text, CaseRecordOf, CaseStatus, FailureRecord};
 use crate::study::{StudyError, Tier};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -127,6 +127,43 @@ pub fn checks_markdown(checks: &[CheckRecord]) -> String {
                 None => "not evaluated",
             },
             c.source.replace('|', "\\|")
+        );
+    }
+    s.push('\n');
+    s
+}
+
+/// Table of the linear systems each case solved: unknowns and non-zeros of the last
+/// converged step's tangent (the largest of the run for the material point methods, whose
+/// active grid changes), Newton iterations and CG iterations over the converged steps. Empty
+/// for results written before these were recorded. Seconds are in `results.json`'s `timing`,
+/// not here, so that a report is the same for the same results on any machine.
+pub fn performance_markdown<C: CaseRecordOf>(cases: &[C]) -> String {
+    if !cases.iter().any(|c| c.steps().iter().any(|s| s.unknowns > 0)) {
+        return String::new();
+    }
+    let mut s = String::from(
+        "## Linear systems
+
+| case | unknowns | nnz(K) | Newton iterations | CG iterations |
+|---|---:|---:|---:|---:|
+",
+    );
+    for c in cases.iter().filter(|c| !c.steps().is_empty()) {
+        let steps = c.steps();
+        let unknowns = steps.iter().map(|s| s.unknowns).max().unwrap_or(0);
+        let nnz = steps.iter().map(|s| s.nonzeros).max().unwrap_or(0);
+        let newton: usize = steps.iter().map(|s| s.residuals.len().saturating_sub(1)).sum();
+        let cg: usize = steps.iter().map(|s| s.linear_iterations).sum();
+        let _ = writeln!(
+            s,
+            "| {} | {unknowns} | {nnz} | {newton} | {} |",
+            c.id(),
+            if cg > 0 {
+                cg.to_string()
+            } else {
+                "— (direct)".into()
+            }
         );
     }
     s.push('\n');

@@ -43,6 +43,19 @@ pub struct StepRecord {
     pub load_factor: f64,
     /// Normalised out-of-balance force before the first and after each Newton update.
     pub residuals: Vec<f64>,
+    /// Unknowns and non-zeros of the step's tangent (0 in results written before they were
+    /// recorded).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub unknowns: usize,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub nonzeros: usize,
+    /// Conjugate-gradient iterations of the step's solves (0 for direct solves).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub linear_iterations: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// Why a case did not converge.
@@ -63,6 +76,9 @@ pub fn step_records(steps: &[StepReport]) -> Vec<StepRecord> {
             step: s.step,
             load_factor: s.load_factor,
             residuals: s.newton.residuals.clone(),
+            unknowns: s.linear.unknowns,
+            nonzeros: s.linear.nonzeros,
+            linear_iterations: s.linear.iterations,
         })
         .collect()
 }
@@ -168,6 +184,8 @@ pub struct Envelope<S, C, M> {
 pub trait CaseRecordOf {
     fn id(&self) -> &str;
     fn status(&self) -> CaseStatus;
+    /// The converged load steps.
+    fn steps(&self) -> &[StepRecord];
 }
 
 /// [`CaseRecordOf`] for a record with `id: String` and `status: CaseStatus` fields.
@@ -179,6 +197,9 @@ macro_rules! case_record {
             }
             fn status(&self) -> $crate::study::results::CaseStatus {
                 self.status
+            }
+            fn steps(&self) -> &[$crate::study::results::StepRecord] {
+                &self.steps
             }
         }
     };

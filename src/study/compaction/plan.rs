@@ -196,6 +196,7 @@ impl CompactionStudy {
             weak_node_treatment: self.weak_nodes.treatment,
             ghost: self.ghost.settings(ppc, s.yield_stress.is_some(), gamma),
             dimension: self.block.dimension as usize,
+            linear_solver: s.linear_solver.unwrap_or_default(),
             ..CompactionSpec::default()
         }
     }
@@ -206,6 +207,9 @@ impl CompactionStudy {
             Some(y) => format!("vm{}", number(y)),
         };
         let mut id = format!("{}-{material}-h{}", method.name(), number(spec.element_size));
+        if spec.linear_solver == crate::linear::LinearSolver::Cg {
+            id.push_str("-cg");
+        }
         if !method.is_fem() {
             id.push_str(&format!("-p{}", spec.points_per_cell));
             if spec.weak_node_tolerance != self.weak_nodes.tolerance {
