@@ -256,6 +256,21 @@ pub fn domains_grid(frame: &DomainFrame) -> UnstructuredGrid {
     g
 }
 
+/// The background grid of a case for [`write_domain_frames`]: `plane()`'s grid in 2D,
+/// `solid()`'s in 3D; `None` if the case has none (a rejected input: its frames are written
+/// alone).
+pub fn grid_part<E>(
+    dimension: usize,
+    plane: impl FnOnce() -> Result<crate::grid::Grid<2>, E>,
+    solid: impl FnOnce() -> Result<crate::grid::Grid<3>, E>,
+) -> Option<UnstructuredGrid> {
+    if dimension == 3 {
+        solid().ok().map(|g| vtk::background_grid(&g, &[]))
+    } else {
+        plane().ok().map(|g| vtk::background_grid(&g, &[]))
+    }
+}
+
 /// Write `<study_dir>/vtk/<case_id>.pvd` and one `.vtu` per frame (`<case_id>/domains_<step>.vtu`,
 /// part 0 of each time step), replacing stale files of the case. With `grid`, the background
 /// grid is written once (`<case_id>/grid.vtu`, its elements as quadrilaterals or hexahedra)

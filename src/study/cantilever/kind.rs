@@ -10,9 +10,8 @@ use crate::problems::cantilever::{solve, CantileverSpec, DomainSnapshot, SolidSn
 use crate::problems::elastica::{bending_stiffness, Elastica};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};
-use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
+use crate::study::vtk_output::{grid_part, write_domain_frames, DomainBox, DomainFrame};
 use crate::study::{StudyError, Tier};
-use crate::vtk;
 use std::path::Path;
 
 /// The elastica of the beam: plane strain (EI = E/(1 − ν²) d³/12 per unit width) or plane
@@ -198,13 +197,7 @@ fn write_case_vtk(
             })
             .collect()
     };
-    // A rejected spec has no grid: its (empty) frames are written alone.
     let s = &case.spec;
-    let grid = if s.dimension == 3 {
-        s.grid_3d().map(|g| vtk::background_grid(&g, &[]))
-    } else {
-        s.grid_2d().map(|g| vtk::background_grid(&g, &[]))
-    }
-    .ok();
+    let grid = grid_part(s.dimension, || s.grid_2d(), || s.grid_3d());
     write_domain_frames(dir, &case.id, &frames, grid.as_ref()).map(|_| ())
 }

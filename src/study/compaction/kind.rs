@@ -8,9 +8,8 @@ use crate::method::Method;
 use crate::problems::compaction::{solve, Domain3dRecord, DomainRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};
-use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
+use crate::study::vtk_output::{grid_part, write_domain_frames, DomainBox, DomainFrame};
 use crate::study::{StudyError, Tier};
-use crate::vtk;
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -178,13 +177,7 @@ fn write_case_vtk(
             vec![(vertical.into(), stress), ("plastic_multiplier".into(), plastic)],
         ),
     ];
-    // A rejected spec has no grid: its (empty) frames are written alone.
     let s = &case.spec;
-    let grid = if s.dimension == 3 {
-        s.grid_3d().map(|g| vtk::background_grid(&g, &[]))
-    } else {
-        s.grid_2d().map(|g| vtk::background_grid(&g, &[]))
-    }
-    .ok();
+    let grid = grid_part(s.dimension, || s.grid_2d(), || s.grid_3d());
     write_domain_frames(dir, &case.id, &frames, grid.as_ref()).map(|_| ())
 }

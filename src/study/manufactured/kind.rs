@@ -12,9 +12,8 @@ use crate::problems::manufactured3d::{solve_3d, stress_deviations_3d, Exact3, Po
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{fresh_points_dir, write_case_data, CaseStatus, SolveRecord, SweepIndex};
 use crate::study::store::{confined, write_file};
-use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
+use crate::study::vtk_output::{grid_part, write_domain_frames, DomainBox, DomainFrame};
 use crate::study::{StudyError, Tier};
-use crate::vtk;
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -219,13 +218,11 @@ fn write_case_vtk(
         scalars: vec![("stress_error".into(), p.stress_error.clone())],
     };
     let (h, n) = (c.spec.element_size(), c.spec.cells);
-    // A rejected spec has no grid: its (empty) frame is written alone.
-    let grid = if d == 3 {
-        Grid::try_new([0.0; 3], [h; 3], [n; 3]).map(|g| vtk::background_grid(&g, &[]))
-    } else {
-        Grid::try_new([0.0; 2], [h; 2], [n; 2]).map(|g| vtk::background_grid(&g, &[]))
-    }
-    .ok();
+    let grid = grid_part(
+        d,
+        || Grid::try_new([0.0; 2], [h; 2], [n; 2]),
+        || Grid::try_new([0.0; 3], [h; 3], [n; 3]),
+    );
     write_domain_frames(dir, &c.id, &[frame], grid.as_ref()).map(|_| ())
 }
 
