@@ -320,6 +320,8 @@ pub fn prolongation(fine: &DofGeometry, origin: [f64; 3], coarse: [f64; 3]) -> (
             for a in 0..dim {
                 let up = (corner >> a) & 1 == 1;
                 node[a] = cell[a] + up as usize;
+                #[cfg(feature = "seeded-bugs")]
+                let up = up != crate::seeded::active(crate::seeded::Bug::SwappedProlongation);
                 w *= if up { t[a] } else { 1.0 - t[a] };
             }
             if w.abs() < 1e-12 {

@@ -22,6 +22,9 @@ pub enum Bug {
     /// GIMP weights without the per-element split of eqs (7)–(10) (Figure 3): the whole
     /// domain integrated against the shape functions of the element holding its centre.
     NoElementSplit = 4,
+    /// Multigrid prolongation with the two weights along each axis swapped (t for the lower
+    /// node, 1 − t for the upper): a fine node on a coarse node draws on its neighbour.
+    SwappedProlongation = 5,
 }
 
 static ACTIVE: AtomicU8 = AtomicU8::new(0);

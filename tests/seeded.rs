@@ -122,6 +122,28 @@ fn gimp_weight_error() -> f64 {
     worst
 }
 
+/// CG iterations per solve and fallbacks of the elastic Q4 compaction at h = 1/16, one
+/// load step (the check of tests/verification/multigrid.rs: at most 20 per solve, none).
+fn multigrid_iterations() -> (f64, usize) {
+    use igimp::fem::QuadElement;
+    use igimp::linear::LinearSolver;
+    use igimp::load_stepping::LoadStepping;
+    use igimp::problems::compaction::{fem_solver, CompactionSpec};
+    let spec = CompactionSpec {
+        element_size: 1.0 / 16.0,
+        load_steps: 1,
+        linear_solver: LinearSolver::Cg,
+        ..CompactionSpec::default()
+    };
+    let (mut fem, _) = fem_solver(&spec, QuadElement::Q4).unwrap();
+    let _ = fem.run();
+    let s = fem.linear_stats();
+    (
+        s.iterations as f64 / s.solves.max(1) as f64,
+        fem.linear_solver_fallbacks(),
+    )
+}
+
 #[test]
 fn every_seeded_bug_is_caught() {
     // The correct kernels pass everything the variants must fail.
@@ -135,6 +157,11 @@ fn every_seeded_bug_is_caught() {
     assert!((rate - 1.64).abs() <= 0.25, "correct stress rate {rate}");
     let w = gimp_weight_error();
     assert!(w < 1e-8, "correct GIMP weights off the quadrature by {w:e}");
+    let (its, fallbacks) = multigrid_iterations();
+    assert!(
+        its <= 20.0 && fallbacks == 0,
+        "correct multigrid: {its} iterations per solve, {fallbacks} fallbacks"
+    );
     eprintln!("control: 14/14 rate checks pass, Newton quadratic, stress rate {rate:.2}, GIMP weights within {w:.1e} of the quadrature");
 
     // 1. No geometric term: the solution is unchanged, so the rate bands cannot see it, but
@@ -164,6 +191,16 @@ fn every_seeded_bug_is_caught() {
             "{bug:?} passed every iGIMP rate band"
         );
     }
+    set(Bug::None);
+
+    // 6. A wrong multigrid prolongation: CG needs far more iterations or falls back.
+    set(Bug::SwappedProlongation);
+    let (its, fallbacks) = multigrid_iterations();
+    eprintln!("swapped prolongation: {its:.1} CG iterations per solve, {fallbacks} fallbacks");
+    assert!(
+        its > 20.0 || fallbacks > 0,
+        "a swapped prolongation passed the multigrid iteration bound"
+    );
     set(Bug::None);
 
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.
