@@ -542,6 +542,19 @@ fn chebyshev(lv: &Level, a: &Csr, b: &[f64], x: &mut [f64], r: &mut [f64], d: &m
     }
 }
 
+/// uᵀv with a summation order fixed by [`CHUNK`] alone: partial sums of fixed chunks in
+/// parallel, added in order. (rayon's `sum` splits where work is stolen, so its result can
+/// change from run to run in the last bits, and CG at an indefinite iterate can then break
+/// down in one run and not in another.)
+pub fn dot(u: &[f64], v: &[f64]) -> f64 {
+    let parts: Vec<f64> = u
+        .par_chunks(CHUNK)
+        .zip(v.par_chunks(CHUNK))
+        .map(|(a, b)| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>())
+        .collect();
+    parts.iter().sum()
+}
+
 /// What a preconditioned conjugate-gradient solve did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CgReport {
@@ -564,7 +577,7 @@ pub fn pcg(
     max_iterations: usize,
 ) -> Result<CgReport, String> {
     let n = b.len();
-    let dot = |u: &[f64], v: &[f64]| -> f64 { u.par_iter().zip(v.par_iter()).map(|(a, b)| a * b).sum() };
+    let dot = |u: &[f64], v: &[f64]| -> f64 { dot(u, v) };
     x.iter_mut().for_each(|v| *v = 0.0);
     let bnorm = dot(b, b).sqrt();
     if bnorm == 0.0 {
