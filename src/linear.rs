@@ -280,7 +280,7 @@ impl SparseSystem {
         self.stats.solves += 1;
         if self.solver == LinearSolver::Cg {
             let original = rhs.to_vec();
-            match self.solve_cg(rhs) {
+            match self.solve_cg(&original, rhs) {
                 Ok(()) if rhs.iter().all(|v| v.is_finite()) => return Ok(()),
                 _ => {
                     self.fallbacks += 1;
@@ -301,15 +301,14 @@ impl SparseSystem {
         crate::multigrid::Csr::from_csc(self.n, &self.col_ptr, &self.row_idx, &self.values)
     }
 
-    /// CG with the multigrid of the pattern's last fresh build while it stays effective:
-    /// the hierarchy (Galerkin products, eigenvalue estimates) is rebuilt from the current
+    /// `x = K⁻¹ b` by CG with the multigrid of the pattern's last fresh build while it stays
+    /// effective: the hierarchy (prolongations, Galerkin products) is rebuilt from the current
     /// matrix when none exists for this pattern, or when a solve with the kept one needs more
     /// than [`REUSE_FACTOR`] times the iterations it took fresh (plus two), or fails; that
     /// solve is then repeated with the fresh hierarchy. Reuse changes the preconditioner, not
     /// the system: every solve still reaches its tolerance on the current matrix.
-    fn solve_cg(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn solve_cg(&mut self, b: &[f64], x: &mut [f64]) -> Result<(), String> {
         use crate::multigrid::{pcg, Hierarchy};
-        let b = rhs.to_vec();
         let rtol = if self.tolerance > 0.0 {
             self.tolerance
         } else {
@@ -322,7 +321,7 @@ impl SparseSystem {
             // Given up once it needs more than the fresh count allows.
             let allowed = (REUSE_FACTOR * *fresh as f64) as usize + 2;
             let start = std::time::Instant::now();
-            let report = pcg(&a, m, &b, rhs, rtol, allowed);
+            let report = pcg(&a, m, b, x, rtol, allowed);
             self.stats.solve_seconds += start.elapsed().as_secs_f64();
             self.stats.iterations += report.as_ref().map_or(allowed, |r| r.iterations);
             match report {
@@ -339,7 +338,7 @@ impl SparseSystem {
         let m = Hierarchy::build(&a, geometry)?;
         self.stats.setup_seconds += start.elapsed().as_secs_f64();
         let start = std::time::Instant::now();
-        let report = pcg(&a, &m, &b, rhs, rtol, MAX_CG_ITERATIONS);
+        let report = pcg(&a, &m, b, x, rtol, MAX_CG_ITERATIONS);
         self.stats.solve_seconds += start.elapsed().as_secs_f64();
         self.stats.iterations += report.as_ref().map_or(MAX_CG_ITERATIONS, |r| r.iterations);
         let report = report?;

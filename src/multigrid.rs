@@ -370,8 +370,6 @@ struct Level {
     r: Csr,
     /// 1 / Σ_j |a_ij| per row (ℓ1-Jacobi).
     inv_diag: Vec<f64>,
-    /// Chebyshev interval of D⁻¹A.
-    bounds: (f64, f64),
 }
 
 /// A multigrid V-cycle for one matrix.
@@ -379,10 +377,6 @@ struct Level {
 pub struct Hierarchy {
     levels: Vec<Level>,
     coarse: SparseSystem,
-    /// Equations per level, finest first (the coarsest last).
-    pub sizes: Vec<usize>,
-    /// Non-zeros per level, finest first.
-    pub nnz: Vec<usize>,
 }
 
 impl Hierarchy {
@@ -406,7 +400,6 @@ impl Hierarchy {
                 .fold(f64::INFINITY, f64::min);
         }
         let mut levels: Vec<Level> = vec![];
-        let (mut sizes, mut nnz) = (vec![], vec![]);
         let mut geo = geometry.clone();
         // The operator of the level being coarsened: the borrowed fine matrix, then owned
         // Galerkin products.
@@ -438,7 +431,6 @@ impl Hierarchy {
             let inv_diag: Vec<f64> = (0..a.rows)
                 .map(|i| 1.0 / a.val[a.ptr[i]..a.ptr[i + 1]].iter().map(|v| v.abs()).sum::<f64>())
                 .collect();
-            let (rows, nz) = (a.rows, a.nnz());
             levels.push(Level {
                 a: match owned.take() {
                     Some(m) => m,
@@ -447,16 +439,11 @@ impl Hierarchy {
                 p,
                 r,
                 inv_diag,
-                bounds: (1.0 / CHEBYSHEV_RATIO, 1.0),
             });
-            sizes.push(rows);
-            nnz.push(nz);
             owned = Some(coarse);
             geo = coarse_geo;
         }
         let a = owned.as_ref().unwrap_or(a);
-        sizes.push(a.rows);
-        nnz.push(a.nnz());
         // The coarsest operator, factorised directly (its CSR is the CSC of its transpose,
         // the same matrix since it is symmetric).
         let mut coarse = SparseSystem::default();
@@ -471,12 +458,7 @@ impl Hierarchy {
             }
         }
         coarse.factorize()?;
-        Ok(Hierarchy {
-            levels,
-            coarse,
-            sizes,
-            nnz,
-        })
+        Ok(Hierarchy { levels, coarse })
     }
 
     /// `x = M⁻¹ b`: one V-cycle from a zero guess.
@@ -495,7 +477,7 @@ impl Hierarchy {
         let n = b.len();
         let mut r = vec![0.0; n];
         let mut d = vec![0.0; n];
-        chebyshev(lv, a, b, x, &mut r, &mut d, true);
+        chebyshev(lv, b, x, &mut r, &mut d, true);
         a.residual(b, x, &mut r);
         let mut bc = vec![0.0; lv.p.cols];
         lv.r.mul_vec(&r, &mut bc);
@@ -503,15 +485,17 @@ impl Hierarchy {
         self.cycle(l + 1, &bc, &mut xc)?;
         lv.p.mul_vec(&xc, &mut r);
         x.par_iter_mut().zip(&r).for_each(|(xi, ei)| *xi += ei);
-        chebyshev(lv, a, b, x, &mut r, &mut d, false);
+        chebyshev(lv, b, x, &mut r, &mut d, false);
         Ok(())
     }
 }
 
-/// [`CHEBYSHEV_DEGREE`] Chebyshev iterations on A x = b preconditioned by D⁻¹ over the
-/// level's interval (Saad alg. 12.1), from x = 0 if `zero_guess`; `r`, `d` are work vectors.
-fn chebyshev(lv: &Level, a: &Csr, b: &[f64], x: &mut [f64], r: &mut [f64], d: &mut [f64], zero_guess: bool) {
-    let (lo, hi) = lv.bounds;
+/// [`CHEBYSHEV_DEGREE`] Chebyshev iterations on the level's A x = b preconditioned by D_ℓ1⁻¹
+/// over [1 / [`CHEBYSHEV_RATIO`], 1] (Saad alg. 12.1), from x = 0 if `zero_guess`; `r`, `d`
+/// are work vectors.
+fn chebyshev(lv: &Level, b: &[f64], x: &mut [f64], r: &mut [f64], d: &mut [f64], zero_guess: bool) {
+    let a = &lv.a;
+    let (lo, hi) = (1.0 / CHEBYSHEV_RATIO, 1.0);
     let theta = 0.5 * (hi + lo);
     let delta = 0.5 * (hi - lo);
     let sigma = theta / delta;
@@ -577,7 +561,6 @@ pub fn pcg(
     max_iterations: usize,
 ) -> Result<CgReport, String> {
     let n = b.len();
-    let dot = |u: &[f64], v: &[f64]| -> f64 { dot(u, v) };
     x.iter_mut().for_each(|v| *v = 0.0);
     let bnorm = dot(b, b).sqrt();
     if bnorm == 0.0 {

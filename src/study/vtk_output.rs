@@ -88,20 +88,8 @@ impl ColumnVtkWriter {
             return;
         }
         let (points, grid) = match state {
-            ColumnState::Mpm(s) => {
-                let len = s.grid.num_nodes();
-                let grid = self.grid_with_displacement(step, len, s.step_increment(), |n, d| {
-                    vtk::background_grid(&s.grid, &[("displacement_increment", n), ("displacement", d)])
-                });
-                (vtk::material_points(&s.points), grid)
-            }
-            ColumnState::Mpm3(s) => {
-                let len = 3 * s.grid.num_nodes();
-                let grid = self.grid_with_displacement(step, len, s.step_increment(), |n, d| {
-                    vtk::background_grid(&s.grid, &[("displacement_increment", n), ("displacement", d)])
-                });
-                (vtk::material_points(&s.points), grid)
-            }
+            ColumnState::Mpm(s) => self.material_point_parts(step, s),
+            ColumnState::Mpm3(s) => self.material_point_parts(step, s),
             ColumnState::Fem(s) => {
                 let g = &s.gauss;
                 let x: Vec<[f64; 3]> = (0..g.len())
@@ -128,23 +116,30 @@ impl ColumnVtkWriter {
         }
     }
 
-    /// The background grid built by `grid(increment, total)` with the nodal displacement
-    /// increment `du` of the step and the running sum Σ Δu, `len` values each (nodes × D);
-    /// zeros at step 0 and while the solver's increment is not of that size.
-    fn grid_with_displacement(
+    /// The points and the background grid of a material point solver after `step`, the grid
+    /// with the step's nodal displacement increment and the running sum Σ Δu (zeros at step 0
+    /// and while the solver's increment is not sized to the grid).
+    fn material_point_parts<const D: usize>(
         &mut self,
         step: usize,
-        len: usize,
-        du: &[f64],
-        grid: impl Fn(&[f64], &[f64]) -> UnstructuredGrid,
-    ) -> UnstructuredGrid {
-        if step == 0 || du.len() != len {
-            let zeros = vec![0.0; len];
-            return grid(&zeros, &zeros);
-        }
-        self.total_du.resize(len, 0.0);
-        self.total_du.iter_mut().zip(du).for_each(|(t, d)| *t += d);
-        grid(du, &self.total_du)
+        s: &crate::mpm::MpmSolver<D>,
+    ) -> (UnstructuredGrid, UnstructuredGrid) {
+        let len = D * s.grid.num_nodes();
+        let du = s.step_increment();
+        let zeros;
+        let (inc, total) = if step == 0 || du.len() != len {
+            zeros = vec![0.0; len];
+            (&zeros[..], &zeros[..])
+        } else {
+            self.total_du.resize(len, 0.0);
+            self.total_du.iter_mut().zip(du).for_each(|(t, d)| *t += d);
+            (du, &self.total_du[..])
+        };
+        let grid = vtk::background_grid(
+            &s.grid,
+            &[("displacement_increment", inc), ("displacement", total)],
+        );
+        (vtk::material_points(&s.points), grid)
     }
 
     fn write(&mut self, step: usize, points: &UnstructuredGrid, grid: &UnstructuredGrid) {
