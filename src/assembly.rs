@@ -89,6 +89,13 @@ impl<const D: usize> LoadStepSystem<'_, D> {
     /// Evaluate all points at the nodal increment and assemble the internal force (in
     /// equation order).
     pub fn assemble_residual(&mut self, f_int: &mut [f64]) -> Result<(), StepFailure> {
+        let start = std::time::Instant::now();
+        let out = self.assemble_residual_untimed(f_int);
+        crate::profile::charge(crate::profile::Phase::Constitutive, start);
+        out
+    }
+
+    fn assemble_residual_untimed(&mut self, f_int: &mut [f64]) -> Result<(), StepFailure> {
         let model = self.model;
         let table = self.table;
         let du = &*self.du_nodal;
@@ -211,6 +218,12 @@ impl<const D: usize> LoadStepSystem<'_, D> {
     /// owned by one thread and filled in point order. Every entry thus receives its
     /// contributions in the same order whatever the thread count.
     pub fn assemble_tangent(&mut self) {
+        let start = std::time::Instant::now();
+        self.assemble_tangent_untimed();
+        crate::profile::charge(crate::profile::Phase::Assembly, start);
+    }
+
+    fn assemble_tangent_untimed(&mut self) {
         const CHUNK: usize = 4096;
         let stride_eq = MAX_POINT_NODES * D;
         self.matrix.clear_values();
@@ -444,6 +457,7 @@ impl<const D: usize> StepWorkspace<D> {
         track: bool,
         f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
     ) -> R {
+        let start = std::time::Instant::now();
         let dofs = DofMap::build(input.num_nodes, &self.table, input.fixed, input.ties);
         let kept = self.fixed_pattern && self.matrix.nnz() > 0 && self.matrix.dim() == dofs.len();
         if kept {
@@ -461,6 +475,7 @@ impl<const D: usize> StepWorkspace<D> {
                     .set_geometry(crate::multigrid::DofGeometry::of_equations(g, &dofs));
             }
         }
+        crate::profile::charge(crate::profile::Phase::Setup, start);
         let mut nodal = vec![0.0; dofs.num_dofs()];
         map_point_forces(&self.table, input.point_forces, &mut nodal);
         for &(dof, force) in input.nodal_forces {
@@ -505,6 +520,11 @@ impl<const D: usize> StepWorkspace<D> {
         crate::load_stepping::LinearRecord {
             unknowns: self.matrix.dim(),
             nonzeros: self.matrix.nnz(),
+            // A CG run's factor (of a fallback) is not its linear system's cost.
+            factor_nonzeros: match self.matrix.solver() {
+                crate::linear::LinearSolver::Cg => 0,
+                _ => self.matrix.stats().factor_nnz,
+            },
             iterations: self.matrix.stats().iterations - iterations_before,
         }
     }

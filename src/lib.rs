@@ -57,6 +57,7 @@ pub mod particles;
 pub mod plot;
 pub mod plot2d;
 pub mod problems;
+pub mod profile;
 pub mod quadrature;
 pub mod render;
 #[cfg(feature = "seeded-bugs")]

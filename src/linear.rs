@@ -38,16 +38,19 @@ pub enum LinearSolver {
     /// Conjugate gradients preconditioned by a geometric multigrid V-cycle on the structured
     /// grid ([`crate::multigrid`]), to the relative tolerance the Newton solver sets from its
     /// residual ([`SparseSystem::set_tolerance`]); needs the equations' positions
-    /// ([`SparseSystem::set_geometry`]). Symmetric positive definite tangents only: if CG
-    /// breaks down or does not converge, the system is solved by LDLᵀ (then LU) and the
-    /// fallback is counted.
+    /// ([`SparseSystem::set_geometry`]). If CG breaks down (a tangent that is not positive
+    /// definite) or does not converge, restarted GMRES with the same multigrid solves the
+    /// system ([`crate::multigrid::gmres`]); only if that fails too is it solved by LDLᵀ
+    /// (then LU). Both switches are counted.
     Cg,
 }
 
 /// Default relative tolerance of an iterative solve when no Newton solver has set one.
 pub const DEFAULT_ITERATIVE_TOLERANCE: f64 = 1e-10;
-/// Most CG iterations of one solve before it falls back to the direct solver.
+/// Most CG iterations of one solve before it switches to GMRES.
 pub const MAX_CG_ITERATIONS: usize = 500;
+/// Most GMRES iterations of one solve before it falls back to the direct solver.
+pub const MAX_GMRES_ITERATIONS: usize = 300;
 /// A kept multigrid is rebuilt once a solve needs more than this many times the iterations
 /// it took fresh (plus two).
 pub const REUSE_FACTOR: f64 = 1.5;
@@ -66,6 +69,21 @@ pub struct LinearStats {
     pub factor_nnz: usize,
     /// Multigrid hierarchies rebuilt because a kept one had become ineffective.
     pub rebuilds: usize,
+    /// Solves that CG could not finish and GMRES took over (iterations of both counted).
+    pub gmres_solves: usize,
+}
+
+impl LinearStats {
+    /// Add the wall time since `start` to `phase` (set-up or solve), here and in the case's
+    /// profile ([`crate::profile`]).
+    fn charge(&mut self, phase: crate::profile::Phase, start: std::time::Instant) {
+        let seconds = start.elapsed().as_secs_f64();
+        match phase {
+            crate::profile::Phase::Solve => self.solve_seconds += seconds,
+            _ => self.setup_seconds += seconds,
+        }
+        crate::profile::charge(phase, start);
+    }
 }
 
 /// A square sparse matrix in compressed sparse column form with cached symbolic
@@ -90,6 +108,8 @@ pub struct SparseSystem {
     /// The multigrid of an earlier matrix of this pattern and the CG iterations it took when
     /// fresh ([`Self::solve_cg`] reuses it).
     hierarchy: Option<(Box<crate::multigrid::Hierarchy>, usize)>,
+    /// The LU factor of the last [`Self::factorize`] under [`LinearSolver::Lu`].
+    lu: Option<Lu<usize, f64>>,
 }
 
 /// A contiguous range of columns of a [`SparseSystem`] whose values one thread may update
@@ -308,7 +328,7 @@ impl SparseSystem {
     /// solve is then repeated with the fresh hierarchy. Reuse changes the preconditioner, not
     /// the system: every solve still reaches its tolerance on the current matrix.
     fn solve_cg(&mut self, b: &[f64], x: &mut [f64]) -> Result<(), String> {
-        use crate::multigrid::{pcg, Hierarchy};
+        use crate::multigrid::{gmres, pcg, Hierarchy};
         let rtol = if self.tolerance > 0.0 {
             self.tolerance
         } else {
@@ -316,13 +336,13 @@ impl SparseSystem {
         };
         let start = std::time::Instant::now();
         let a = self.to_csr();
-        self.stats.setup_seconds += start.elapsed().as_secs_f64();
+        self.stats.charge(crate::profile::Phase::Setup, start);
         if let Some((m, fresh)) = self.hierarchy.as_ref() {
             // Given up once it needs more than the fresh count allows.
             let allowed = (REUSE_FACTOR * *fresh as f64) as usize + 2;
             let start = std::time::Instant::now();
             let report = pcg(&a, m, b, x, rtol, allowed);
-            self.stats.solve_seconds += start.elapsed().as_secs_f64();
+            self.stats.charge(crate::profile::Phase::Solve, start);
             self.stats.iterations += report.as_ref().map_or(allowed, |r| r.iterations);
             match report {
                 Ok(_) => return Ok(()),
@@ -336,31 +356,62 @@ impl SparseSystem {
         let start = std::time::Instant::now();
         self.hierarchy = None;
         let m = Hierarchy::build(&a, geometry)?;
-        self.stats.setup_seconds += start.elapsed().as_secs_f64();
+        self.stats.charge(crate::profile::Phase::Setup, start);
         let start = std::time::Instant::now();
         let report = pcg(&a, &m, b, x, rtol, MAX_CG_ITERATIONS);
-        self.stats.solve_seconds += start.elapsed().as_secs_f64();
+        self.stats.charge(crate::profile::Phase::Solve, start);
         self.stats.iterations += report.as_ref().map_or(MAX_CG_ITERATIONS, |r| r.iterations);
-        let report = report?;
+        let report = match report {
+            Ok(r) => r,
+            Err(cg) => {
+                let start = std::time::Instant::now();
+                let report = gmres(&a, &m, b, x, rtol, MAX_GMRES_ITERATIONS);
+                self.stats.charge(crate::profile::Phase::Solve, start);
+                self.stats.gmres_solves += 1;
+                self.stats.iterations += report.as_ref().map_or(MAX_GMRES_ITERATIONS, |r| r.iterations);
+                report.map_err(|e| format!("{cg}; {e}"))?
+            }
+        };
         self.hierarchy = Some((Box::new(m), report.iterations));
         Ok(())
     }
 
-    /// Factorise (symmetric solvers: LDLᵀ or LLᵀ) for later [`Self::solve_factorized`].
+    /// Factorise (LDLᵀ, LLᵀ or LU) for later [`Self::solve_factorized`].
     pub fn factorize(&mut self) -> Result<(), String> {
         if self.n == 0 {
             return Ok(());
         }
-        if !matches!(self.solver, LinearSolver::Ldlt | LinearSolver::Llt) {
-            return Err("factorize: LDLᵀ or LLᵀ only".into());
+        match self.solver {
+            LinearSolver::Ldlt | LinearSolver::Llt => self.factorize_symmetric(),
+            LinearSolver::Lu => {
+                let n = self.n;
+                let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
+                if self.symbolic.is_none() {
+                    self.symbolic = Some(SymbolicLu::try_new(sym).map_err(|e| format!("{e:?}"))?);
+                }
+                let symbolic = self.symbolic.clone().expect("symbolic factorisation present");
+                let mat = SparseColMatRef::new(sym, &self.values);
+                self.lu = Some(Lu::try_new_with_symbolic(symbolic, mat).map_err(|e| format!("{e:?}"))?);
+                Ok(())
+            }
+            LinearSolver::Cg => Err("factorize: a direct solver only (LDLᵀ, LLᵀ or LU)".into()),
         }
-        self.factorize_symmetric()
     }
 
     /// Solve with the factor of the last [`Self::factorize`].
     pub fn solve_factorized(&self, rhs: &mut [f64]) -> Result<(), String> {
         if self.n == 0 {
             return Ok(());
+        }
+        if self.solver == LinearSolver::Lu {
+            let lu = self.lu.as_ref().ok_or("solve_factorized: not factorised")?;
+            let n = self.n;
+            lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, 1));
+            return if rhs.iter().all(|v| v.is_finite()) {
+                Ok(())
+            } else {
+                Err("the solution of the linear system is not finite (singular tangent)".into())
+            };
         }
         let symbolic = self
             .symbolic_cholesky
@@ -385,14 +436,8 @@ impl SparseSystem {
         }
     }
 
+    /// Factorise (set-up) and solve (solve), LU when a symmetric factorisation fails.
     fn solve_direct(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        let start = std::time::Instant::now();
-        let out = self.solve_direct_untimed(rhs);
-        self.stats.setup_seconds += start.elapsed().as_secs_f64();
-        out
-    }
-
-    fn solve_direct_untimed(&mut self, rhs: &mut [f64]) -> Result<(), String> {
         if self.solver != LinearSolver::Lu {
             let original = rhs.to_vec();
             match self.solve_symmetric(rhs) {
@@ -412,6 +457,7 @@ impl SparseSystem {
     }
 
     fn solve_lu(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        let start = std::time::Instant::now();
         let sym = SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx);
         if self.symbolic.is_none() {
             self.symbolic = Some(SymbolicLu::try_new(sym).map_err(|e| format!("{e:?}"))?);
@@ -419,15 +465,24 @@ impl SparseSystem {
         let symbolic = self.symbolic.clone().expect("symbolic factorisation present");
         let mat = SparseColMatRef::new(sym, &self.values);
         let lu = Lu::try_new_with_symbolic(symbolic, mat).map_err(|e| format!("{e:?}"))?;
+        self.stats.charge(crate::profile::Phase::Setup, start);
+        let start = std::time::Instant::now();
         let n = self.n;
         lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, 1));
+        self.stats.charge(crate::profile::Phase::Solve, start);
         Ok(())
     }
 
     /// LDLᵀ or LLᵀ of the lower triangle, then the solve.
     fn solve_symmetric(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        self.factorize_symmetric()?;
-        self.solve_factorized(rhs)
+        let start = std::time::Instant::now();
+        let factored = self.factorize_symmetric();
+        self.stats.charge(crate::profile::Phase::Setup, start);
+        factored?;
+        let start = std::time::Instant::now();
+        let solved = self.solve_factorized(rhs);
+        self.stats.charge(crate::profile::Phase::Solve, start);
+        solved
     }
 
     /// LDLᵀ or LLᵀ of the lower triangle (faer's supernodal/simplicial Cholesky with an AMD

@@ -47,12 +47,15 @@ impl StepReport {
     }
 }
 
-/// The linear systems of one converged increment: unknowns and non-zeros of its tangent and
-/// the CG iterations of its solves (0 for direct solves).
+/// The linear systems of one converged increment: unknowns and non-zeros of its tangent, the
+/// non-zeros of its last LDLᵀ/LLᵀ factor (0 if none) and the CG iterations of its solves (0
+/// for direct solves).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct LinearRecord {
     pub unknowns: usize,
     pub nonzeros: usize,
+    #[serde(default)]
+    pub factor_nonzeros: usize,
     pub iterations: usize,
 }
 

@@ -212,6 +212,13 @@ impl<const D: usize> MpmSolver<D> {
 
     /// Evaluate the weights of every point on the grid at the current positions and domains.
     pub fn build_supports(&mut self) -> Result<(), StepFailure> {
+        let start = std::time::Instant::now();
+        let out = self.build_supports_untimed();
+        crate::profile::charge(crate::profile::Phase::Weights, start);
+        out
+    }
+
+    fn build_supports_untimed(&mut self) -> Result<(), StepFailure> {
         let basis = self.settings.basis;
         self.work.table.clear();
         let mut sup = Support::<D>::default();
@@ -254,6 +261,7 @@ impl<const D: usize> MpmSolver<D> {
 
     /// Form the ghost operator for the current configuration (after [`Self::build_supports`]).
     pub fn build_ghost(&mut self) {
+        let start = std::time::Instant::now();
         if self.settings.ghost.is_on() {
             cell_fill(
                 &self.grid,
@@ -266,6 +274,7 @@ impl<const D: usize> MpmSolver<D> {
         }
         self.ghost
             .build(&self.grid, &self.settings.ghost, self.model.young_modulus());
+        crate::profile::charge(crate::profile::Phase::Weights, start);
     }
 
     /// Supports of the last [`Self::build_supports`].

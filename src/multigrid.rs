@@ -1,5 +1,6 @@
 //! Geometric multigrid on the structured background grid (or FEM mesh), as the preconditioner
-//! of a conjugate-gradient solve of the Newton systems ([`crate::linear::LinearSolver::Cg`]).
+//! of a conjugate-gradient solve of the Newton systems ([`crate::linear::LinearSolver::Cg`]),
+//! and of restarted GMRES where CG breaks down (indefinite or non-symmetric tangents).
 //!
 //! The grids of this code are structured, which is where multigrid is optimal: each coarse
 //! level is the grid of twice the spacing, and the prolongation P interpolates every
@@ -9,7 +10,7 @@
 //! exists where some fine equation draws on it. The coarse operators are Galerkin products
 //! A_{l+1} = Pᵀ A_l P, so the ghost penalty, the contact of slivers and the material tangent
 //! all pass to the coarse levels; the coarsest (at most [`COARSE_SIZE`] equations) is
-//! factorised directly. Smoothing is Chebyshev of degree [`CHEBYSHEV_DEGREE`] on D_ℓ1⁻¹A,
+//! factorised directly (LDLᵀ, or LU if it is not symmetric). Smoothing is Chebyshev of degree [`CHEBYSHEV_DEGREE`] on D_ℓ1⁻¹A,
 //! D_ℓ1 = diag(Σ_j |a_ij|), whose spectrum Gershgorin bounds by 1: the interval needs no
 //! eigenvalue estimate and cannot fall short of λ_max, which made the smoother diverge at
 //! 2e6 unknowns with a power-method estimate, and nearly empty cells (tiny diagonals) do not
@@ -24,8 +25,8 @@
 //! operators); Adams, Brezina, Hu & Tuminaro, "Parallel multigrid smoothing: polynomial
 //! versus Gauss–Seidel", J. Comput. Phys. 188 (2003) (Chebyshev smoothers); Baker, Falgout,
 //! Kolev & Yang, "Multigrid smoothers for ultraparallel computing", SIAM J. Sci. Comput. 33
-//! (2011) (ℓ1-Jacobi); Saad, *Iterative Methods for Sparse Linear Systems* (2003), alg. 6.18 (PCG) and
-//! alg. 12.1 (Chebyshev).
+//! (2011) (ℓ1-Jacobi); Saad, *Iterative Methods for Sparse Linear Systems* (2003), alg. 6.18 (PCG), alg. 9.5
+//! (right-preconditioned GMRES) and alg. 12.1 (Chebyshev).
 
 use crate::linear::{LinearSolver, SparseSystem};
 use rayon::prelude::*;
@@ -372,6 +373,18 @@ struct Level {
     inv_diag: Vec<f64>,
 }
 
+/// Is `a` symmetric to rounding (|a_ij − a_ji| ≤ 1e-10 max |a|, same pattern both ways)?
+fn is_symmetric(a: &Csr) -> bool {
+    let t = a.transpose();
+    let scale = a.val.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    t.ptr == a.ptr
+        && t.idx == a.idx
+        && t.val
+            .iter()
+            .zip(&a.val)
+            .all(|(x, y)| (x - y).abs() <= 1e-10 * scale)
+}
+
 /// A multigrid V-cycle for one matrix.
 #[derive(Debug)]
 pub struct Hierarchy {
@@ -444,17 +457,23 @@ impl Hierarchy {
             geo = coarse_geo;
         }
         let a = owned.as_ref().unwrap_or(a);
-        // The coarsest operator, factorised directly (its CSR is the CSC of its transpose,
-        // the same matrix since it is symmetric).
+        // The coarsest operator, factorised directly: LDLᵀ if it is symmetric (to rounding),
+        // LU if not, so that the coarse correction is exact for GMRES on a non-symmetric
+        // tangent. The pattern is structurally symmetric (every tangent's is), so the rows'
+        // patterns are the columns'.
         let mut coarse = SparseSystem::default();
-        coarse.set_solver(LinearSolver::Ldlt);
+        coarse.set_solver(if is_symmetric(a) {
+            LinearSolver::Ldlt
+        } else {
+            LinearSolver::Lu
+        });
         let columns: Vec<Vec<usize>> = (0..a.rows)
             .map(|i| a.idx[a.ptr[i]..a.ptr[i + 1]].to_vec())
             .collect();
         coarse.set_pattern(columns);
         for i in 0..a.rows {
             for k in a.ptr[i]..a.ptr[i + 1] {
-                coarse.add(a.idx[k], i, a.val[k]);
+                coarse.add(i, a.idx[k], a.val[k]);
             }
         }
         coarse.factorize()?;
@@ -539,7 +558,7 @@ pub fn dot(u: &[f64], v: &[f64]) -> f64 {
     parts.iter().sum()
 }
 
-/// What a preconditioned conjugate-gradient solve did.
+/// What a preconditioned Krylov solve ([`pcg`] or [`gmres`]) did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CgReport {
     pub iterations: usize,
@@ -607,5 +626,130 @@ pub fn pcg(
     }
     Err(format!(
         "CG did not reach the relative residual {rtol:e} in {max_iterations} iterations"
+    ))
+}
+
+/// Krylov vectors kept by [`gmres`] before it restarts.
+pub const GMRES_RESTART: usize = 30;
+
+/// Solve `A x = b` by restarted GMRES(`GMRES_RESTART`) right-preconditioned with `m`'s V-cycle
+/// (Saad alg. 9.5), from x = 0, until ‖b − A x‖ ≤ `rtol` ‖b‖. Unlike [`pcg`] it needs
+/// neither A nor M positive definite nor A symmetric: it serves the tangents on which CG
+/// breaks down (a buckling cantilever's, far from equilibrium). Right preconditioning makes
+/// the Arnoldi residual the true one, so the stopping test is on ‖b − A x‖; each cycle's
+/// update is checked against a fresh residual before the next. An error if `max_iterations`
+/// pass first or the Krylov space stops growing short of the tolerance.
+pub fn gmres(
+    a: &Csr,
+    m: &Hierarchy,
+    b: &[f64],
+    x: &mut [f64],
+    rtol: f64,
+    max_iterations: usize,
+) -> Result<CgReport, String> {
+    let n = b.len();
+    let k = GMRES_RESTART;
+    x.iter_mut().for_each(|v| *v = 0.0);
+    let bnorm = dot(b, b).sqrt();
+    if bnorm == 0.0 {
+        return Ok(CgReport {
+            iterations: 0,
+            relative_residual: 0.0,
+        });
+    }
+    let target = rtol * bnorm;
+    let mut v: Vec<Vec<f64>> = (0..=k).map(|_| vec![0.0; n]).collect();
+    let mut h = vec![[0.0; GMRES_RESTART]; GMRES_RESTART + 1];
+    let (mut cs, mut sn) = ([0.0; GMRES_RESTART], [0.0; GMRES_RESTART]);
+    let mut g = [0.0; GMRES_RESTART + 1];
+    let mut z = vec![0.0; n];
+    let mut w = vec![0.0; n];
+    let mut r = b.to_vec();
+    let mut beta = bnorm;
+    let mut iterations = 0;
+    while iterations < max_iterations {
+        v[0].iter_mut().zip(&r).for_each(|(vi, ri)| *vi = ri / beta);
+        g.iter_mut().for_each(|gi| *gi = 0.0);
+        g[0] = beta;
+        let mut used = 0;
+        for j in 0..k {
+            if iterations == max_iterations {
+                break;
+            }
+            iterations += 1;
+            m.apply(&v[j], &mut z)?;
+            a.mul_vec(&z, &mut w);
+            // Modified Gram–Schmidt against the basis so far.
+            for i in 0..=j {
+                let hij = dot(&w, &v[i]);
+                h[i][j] = hij;
+                w.par_iter_mut()
+                    .zip(v[i].par_iter())
+                    .for_each(|(wi, vi)| *wi -= hij * vi);
+            }
+            let norm = dot(&w, &w).sqrt();
+            h[j + 1][j] = norm;
+            // Earlier rotations, then the one that zeroes h[j+1][j].
+            for i in 0..j {
+                let t = cs[i] * h[i][j] + sn[i] * h[i + 1][j];
+                h[i + 1][j] = -sn[i] * h[i][j] + cs[i] * h[i + 1][j];
+                h[i][j] = t;
+            }
+            let d = h[j][j].hypot(h[j + 1][j]);
+            if d == 0.0 {
+                return Err(format!(
+                    "GMRES broke down at iteration {iterations} (zero Hessenberg column)"
+                ));
+            }
+            cs[j] = h[j][j] / d;
+            sn[j] = h[j + 1][j] / d;
+            h[j][j] = d;
+            h[j + 1][j] = 0.0;
+            g[j + 1] = -sn[j] * g[j];
+            g[j] *= cs[j];
+            used = j + 1;
+            // A lucky breakdown (w = 0) means the solution is in the space: stop either way.
+            if g[j + 1].abs() <= target || norm == 0.0 {
+                break;
+            }
+            let inv = 1.0 / norm;
+            v[j + 1]
+                .par_iter_mut()
+                .zip(w.par_iter())
+                .for_each(|(vi, wi)| *vi = wi * inv);
+        }
+        // y = H⁻¹ g (upper triangular), x += M⁻¹ (V y).
+        let mut y = [0.0; GMRES_RESTART];
+        for i in (0..used).rev() {
+            let s: f64 = (i + 1..used).map(|l| h[i][l] * y[l]).sum();
+            y[i] = (g[i] - s) / h[i][i];
+        }
+        w.iter_mut().for_each(|wi| *wi = 0.0);
+        for (vi, yi) in v.iter().zip(&y[..used]) {
+            w.par_iter_mut()
+                .zip(vi.par_iter())
+                .for_each(|(wi, vij)| *wi += yi * vij);
+        }
+        m.apply(&w, &mut z)?;
+        x.par_iter_mut().zip(z.par_iter()).for_each(|(xi, zi)| *xi += zi);
+        // The true residual, so that rounding in the rotations cannot pass a wrong answer.
+        a.mul_vec(x, &mut w);
+        r.par_iter_mut()
+            .zip(b.par_iter().zip(w.par_iter()))
+            .for_each(|(ri, (bi, wi))| *ri = bi - wi);
+        beta = dot(&r, &r).sqrt();
+        if !beta.is_finite() {
+            return Err(format!("GMRES diverged at iteration {iterations}"));
+        }
+        if beta <= target {
+            return Ok(CgReport {
+                iterations,
+                relative_residual: beta / bnorm,
+            });
+        }
+    }
+    Err(format!(
+        "GMRES did not reach the relative residual {rtol:e} in {max_iterations} iterations (at {:e})",
+        beta / bnorm
     ))
 }

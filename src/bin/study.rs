@@ -17,6 +17,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+/// Counts each case's heap bytes for the `timing.costs` of `results.json`.
+#[global_allocator]
+static ALLOCATOR: igimp::profile::CountingAllocator = igimp::profile::CountingAllocator;
+
 #[derive(Debug, Parser)]
 #[command(
     name = "study",

@@ -167,7 +167,10 @@ impl<const D: usize> UlCore<D> {
         loads: &FullLoads<'_, D>,
         build_supports: impl FnOnce(&mut SupportTable<D>) -> Result<(), StepFailure>,
     ) -> Result<Increment, (StepFailure, Vec<f64>)> {
-        build_supports(&mut self.work.table).map_err(|f| (f, vec![]))?;
+        crate::profile::timed(crate::profile::Phase::Weights, || {
+            build_supports(&mut self.work.table)
+        })
+        .map_err(|f| (f, vec![]))?;
         let before = self.work.matrix.stats().iterations;
         let report = self.with_input(states, num_nodes, loads, load_factor, |work, input| {
             work.solve(input, newton)

@@ -139,7 +139,7 @@ pub fn report_markdown(results: &CantileverResults) -> String {
         s.push('\n');
     }
     s.push_str(&super::gci_markdown(&results.measures.gci));
-    s.push_str(&super::performance_markdown(&results.cases));
+    s.push_str(&super::performance_markdown(&results.cases, &results.timing));
     s.push_str(&failures_markdown(
         results
             .cases

@@ -223,7 +223,7 @@ pub fn report_markdown(results: &CompactionResults) -> String {
     }
     s.push('\n');
     s.push_str(&cases_table(results));
-    s.push_str(&super::performance_markdown(&results.cases));
+    s.push_str(&super::performance_markdown(&results.cases, &results.timing));
     s.push_str(&failures_markdown(
         results
             .cases

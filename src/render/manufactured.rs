@@ -126,7 +126,7 @@ pub fn report_markdown(results: &Results) -> String {
     }
     s.push('\n');
     s.push_str(&checks_markdown(&results.checks));
-    s.push_str(&super::performance_markdown(&results.cases));
+    s.push_str(&super::performance_markdown(&results.cases, &results.timing));
     s.push_str(&failures_markdown(
         results
             .cases

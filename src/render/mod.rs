@@ -9,7 +9,7 @@ pub mod compaction;
 pub mod manufactured;
 
 use crate::study::checks::{check_counts, CheckRecord, GciRecord};
-use crate::study::results::{write_text, CaseRecordOf, CaseStatus, FailureRecord};
+use crate::study::results::{write_text, CaseRecordOf, CaseStatus, FailureRecord, Timing};
 use crate::study::{StudyError, Tier};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -133,42 +133,96 @@ pub fn checks_markdown(checks: &[CheckRecord]) -> String {
     s
 }
 
-/// Table of the linear systems each case solved: unknowns and non-zeros of the last
-/// converged step's tangent (the largest of the run for the material point methods, whose
-/// active grid changes), Newton iterations and CG iterations over the converged steps. Empty
-/// for results written before these were recorded. Seconds are in `results.json`'s `timing`,
-/// not here, so that a report is the same for the same results on any machine.
-pub fn performance_markdown<C: CaseRecordOf>(cases: &[C]) -> String {
-    if !cases.iter().any(|c| c.steps().iter().any(|s| s.unknowns > 0)) {
-        return String::new();
-    }
-    let mut s = String::from(
-        "## Linear systems
+/// Tables of what each case solved and what it cost.
+///
+/// *Linear systems* (deterministic): unknowns and non-zeros of the last converged step's
+/// tangent (the largest of the run for the material point methods, whose active grid
+/// changes), the non-zeros of its LDLᵀ/LLᵀ factor, Newton iterations and CG iterations over
+/// the converged steps. *Cost* (wall-clock, from `results.json`'s `timing`): each case's
+/// seconds by phase ([`crate::profile::Phase`]) and its heap peak. Both are empty for results
+/// written before they were recorded.
+pub fn performance_markdown<C: CaseRecordOf>(cases: &[C], timing: &Timing) -> String {
+    let mut s = String::new();
+    if cases.iter().any(|c| c.steps().iter().any(|s| s.unknowns > 0)) {
+        s.push_str(
+            "## Linear systems
 
-| case | unknowns | nnz(K) | Newton iterations | CG iterations |
-|---|---:|---:|---:|---:|
+| case | unknowns | nnz(K) | nnz(L) | Newton iterations | CG iterations |
+|---|---:|---:|---:|---:|---:|
 ",
+        );
+        for c in cases.iter().filter(|c| !c.steps().is_empty()) {
+            let steps = c.steps();
+            let unknowns = steps.iter().map(|s| s.unknowns).max().unwrap_or(0);
+            let nnz = steps.iter().map(|s| s.nonzeros).max().unwrap_or(0);
+            let factor = steps.iter().map(|s| s.factor_nonzeros).max().unwrap_or(0);
+            let newton: usize = steps.iter().map(|s| s.residuals.len().saturating_sub(1)).sum();
+            let cg: usize = steps.iter().map(|s| s.linear_iterations).sum();
+            let _ = writeln!(
+                s,
+                "| {} | {unknowns} | {nnz} | {} | {newton} | {} |",
+                c.id(),
+                if factor > 0 {
+                    factor.to_string()
+                } else {
+                    "—".into()
+                },
+                if cg > 0 {
+                    cg.to_string()
+                } else {
+                    "— (direct)".into()
+                }
+            );
+        }
+        s.push('\n');
+    }
+    if timing.costs.is_empty() {
+        return s;
+    }
+    let _ = write!(
+        s,
+        "## Cost
+
+Wall seconds on {} threads, by phase: weights (supports, GIMP weights or shape functions, ghost \
+faces), constitutive (point updates and internal force), tangent assembly, set-up (dof map, \
+pattern, factorisation or multigrid) and solve (triangular solves or CG iterations); *other* \
+is the rest of the case (load stepping, commits, domain updates, output). Cases run \
+concurrently and share the cores, so these times vary from run to run; the heap peak is the \
+case's own (its largest live heap above what it started with).{}
+
+| case | wall s | weights | constitutive | assembly | set-up | solve | other | heap peak MiB |
+|---|---:|---:|---:|---:|---:|---:|---:|---:|
+",
+        timing.threads,
+        timing.peak_resident_bytes.map_or(String::new(), |b| format!(
+            " The whole run peaked at {:.0} MiB resident.",
+            b as f64 / MIB
+        ))
     );
-    for c in cases.iter().filter(|c| !c.steps().is_empty()) {
-        let steps = c.steps();
-        let unknowns = steps.iter().map(|s| s.unknowns).max().unwrap_or(0);
-        let nnz = steps.iter().map(|s| s.nonzeros).max().unwrap_or(0);
-        let newton: usize = steps.iter().map(|s| s.residuals.len().saturating_sub(1)).sum();
-        let cg: usize = steps.iter().map(|s| s.linear_iterations).sum();
+    for c in cases {
+        let Some(k) = timing.costs.get(c.id()) else {
+            continue;
+        };
         let _ = writeln!(
             s,
-            "| {} | {unknowns} | {nnz} | {newton} | {} |",
+            "| {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {} |",
             c.id(),
-            if cg > 0 {
-                cg.to_string()
-            } else {
-                "— (direct)".into()
-            }
+            k.seconds,
+            k.weights,
+            k.constitutive,
+            k.assembly,
+            k.setup,
+            k.solve,
+            k.other(),
+            k.heap_peak_bytes
+                .map_or("—".into(), |b| format!("{:.1}", b as f64 / MIB))
         );
     }
     s.push('\n');
     s
 }
+
+const MIB: f64 = 1024.0 * 1024.0;
 
 /// Table of the cases that did not converge: id, status, step, reason and the last residuals.
 pub fn failures_markdown<'a>(

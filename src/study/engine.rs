@@ -17,7 +17,7 @@ use super::store::CaseStore;
 use super::vtk_output::{pvd_path, VtkOptions};
 use super::{Distribution, StudyError, Tier};
 use crate::method::Method;
-use rayon::prelude::*;
+use crate::profile::{self, CaseCost};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -189,39 +189,55 @@ impl Default for RunOptions<'_> {
     }
 }
 
-/// Solve `cases` on the rayon pool, most expensive first (by `cost`), and return the results
-/// in the order of `cases` with each one's wall seconds.
+/// Solve `cases`, most expensive first (by `cost`), as many at once as the rayon pool has
+/// threads, and return the results in the order of `cases` with what each cost. Each worker
+/// runs its cases on a rayon pool of its own ([`profile::CasePool`]) with as many threads, so
+/// that a case's phases and heap peak are accounted to it alone; a case left to finish alone
+/// still has every thread for its own parallel loops.
 pub fn run_cases<C: Sync, R: Send>(
     cases: &[C],
     cost: impl Fn(&C) -> f64 + Sync,
     solve: impl Fn(&C) -> R + Sync,
-) -> Vec<(R, f64)> {
+) -> Vec<(R, CaseCost)> {
     let mut order: Vec<usize> = (0..cases.len()).collect();
     order.sort_by(|&a, &b| cost(&cases[b]).total_cmp(&cost(&cases[a])).then(a.cmp(&b)));
-    let mut solved: Vec<(usize, R, f64)> = order
-        .par_iter()
-        .map(|&i| {
-            let t = Instant::now();
-            let r = solve(&cases[i]);
-            (i, r, t.elapsed().as_secs_f64())
-        })
-        .collect();
+    let threads = rayon::current_num_threads().max(1);
+    let next = AtomicUsize::new(0);
+    let solved = std::sync::Mutex::new(Vec::<(usize, R, CaseCost)>::with_capacity(cases.len()));
+    std::thread::scope(|scope| {
+        for _ in 0..threads.min(order.len()) {
+            scope.spawn(|| {
+                let pool = profile::CasePool::new(threads);
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&i) = order.get(k) else { break };
+                    let (r, c) = pool.run(|| solve(&cases[i]));
+                    solved.lock().unwrap_or_else(|e| e.into_inner()).push((i, r, c));
+                }
+            });
+        }
+    });
+    let mut solved = solved.into_inner().unwrap_or_else(|e| e.into_inner());
     solved.sort_by_key(|s| s.0);
-    solved.into_iter().map(|(_, r, t)| (r, t)).collect()
+    solved.into_iter().map(|(_, r, c)| (r, c)).collect()
 }
 
-/// A finished case as the store keeps it: its output and the seconds it took (so that a
-/// resumed run reports the original timing).
+/// A finished case as the store keeps it: its output and the seconds it took, by phase (so
+/// that a resumed run reports the original timing).
 #[derive(Serialize, Deserialize)]
 struct StoredCase<R> {
     output: R,
     seconds: f64,
+    /// Absent in cases stored before phases were accounted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    cost: Option<CaseCost>,
 }
 
-/// Each case's output with its wall seconds, and how many were read back from the store.
-type Solved<K> = (Vec<(<K as StudyKind>::Output, f64)>, usize);
-/// A case's output and, if read back from the store, the seconds it originally took.
-type Finished<K> = (<K as StudyKind>::Output, Option<f64>);
+/// Each case's output with its seconds and what they were spent on (unless stored before
+/// phases were accounted), and how many were read back from the store.
+type Solved<K> = (Vec<(<K as StudyKind>::Output, f64, Option<CaseCost>)>, usize);
+/// A case's output and, if read back from the store, its original seconds and cost.
+type Finished<K> = (<K as StudyKind>::Output, Option<(f64, Option<CaseCost>)>);
 
 /// Solve (or read back) every case this process owns: with `resume` (or `--merge`), a case
 /// stored earlier under the same id and input hash (with `--vtk`, whose `.pvd` exists too) is
@@ -269,7 +285,7 @@ fn solve_all<K: StudyKind>(
                 if let Some(s) = store.load::<StoredCase<K::Output>>(&key.id, &key.hash) {
                     resumed.fetch_add(1, Ordering::Relaxed);
                     done(&key.id, &s.output);
-                    return Ok(Some((s.output, Some(s.seconds))));
+                    return Ok(Some((s.output, Some((s.seconds, s.cost)))));
                 }
             }
             if merge {
@@ -282,17 +298,28 @@ fn solve_all<K: StudyKind>(
             let t = Instant::now();
             let output = study.solve(c, vtk.as_ref())?;
             let seconds = t.elapsed().as_secs_f64();
-            let stored = StoredCase { output, seconds };
+            // The phases so far; the engine's own measure (store write included) replaces
+            // this one for a case solved now.
+            let cost = CaseCost {
+                seconds,
+                ..profile::current()
+            };
+            let stored = StoredCase {
+                output,
+                seconds,
+                cost: Some(cost),
+            };
             store.save(&key.id, &key.hash, &stored)?;
             done(&key.id, &stored.output);
-            Ok(Some((stored.output, Some(seconds))))
+            Ok(Some((stored.output, None)))
         },
     );
     let mut out = Vec::with_capacity(outputs.len());
     let mut missing = vec![];
-    for (c, (r, secs)) in own.iter().zip(outputs) {
+    for (c, (r, cost)) in own.iter().zip(outputs) {
         match r? {
-            Some((o, stored_secs)) => out.push((o, stored_secs.unwrap_or(secs))),
+            Some((o, Some((seconds, stored)))) => out.push((o, seconds, stored)),
+            Some((o, None)) => out.push((o, cost.seconds, Some(cost))),
             None => missing.push(study.key(c).id),
         }
     }
@@ -327,11 +354,15 @@ pub fn run<K: StudyKind>(
     let (cases, sweep_cases) = study.cases(tier);
     let (solved, resumed) = solve_all(study, &cases, options)?;
     let mut times = std::collections::BTreeMap::new();
+    let mut costs = std::collections::BTreeMap::new();
     let mut records = Vec::with_capacity(solved.len());
     let mut outputs = Vec::with_capacity(solved.len());
-    for (o, secs) in solved {
+    for (o, seconds, cost) in solved {
         let r = K::record(&o).clone();
-        times.insert(r.id().to_string(), secs);
+        times.insert(r.id().to_string(), seconds);
+        if let Some(cost) = cost {
+            costs.insert(r.id().to_string(), cost);
+        }
         records.push(r);
         outputs.push(o);
     }
@@ -346,10 +377,13 @@ pub fn run<K: StudyKind>(
             wall_seconds: 0.0,
             threads: rayon::current_num_threads(),
             cases: times,
+            costs,
+            peak_resident_bytes: None,
         },
     };
     K::measure(&mut results);
     results.timing.wall_seconds = start.elapsed().as_secs_f64();
+    results.timing.peak_resident_bytes = profile::peak_resident_bytes();
     Ok(Run {
         results,
         outputs,

@@ -10,6 +10,7 @@ use super::checks::{check_counts, CheckRecord};
 use super::{StudyError, Tier};
 use crate::error::SolveError;
 use crate::load_stepping::StepReport;
+use crate::profile::CaseCost;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -49,6 +50,9 @@ pub struct StepRecord {
     pub unknowns: usize,
     #[serde(default, skip_serializing_if = "is_zero")]
     pub nonzeros: usize,
+    /// Non-zeros of the step's last LDLᵀ/LLᵀ factor (0: none, or not recorded).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub factor_nonzeros: usize,
     /// Conjugate-gradient iterations of the step's solves (0 for direct solves).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub linear_iterations: usize,
@@ -78,6 +82,7 @@ pub fn step_records(steps: &[StepReport]) -> Vec<StepRecord> {
             residuals: s.newton.residuals.clone(),
             unknowns: s.linear.unknowns,
             nonzeros: s.linear.nonzeros,
+            factor_nonzeros: s.linear.factor_nonzeros,
             linear_iterations: s.linear.iterations,
         })
         .collect()
@@ -146,6 +151,13 @@ pub struct Timing {
     pub threads: usize,
     /// Wall seconds of each case, by case id (a resumed case keeps its original time).
     pub cases: BTreeMap<String, f64>,
+    /// Each case's seconds by phase and its heap peak, by case id (absent in results written
+    /// before they were accounted; a case resumed from such a store has its seconds only).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub costs: BTreeMap<String, CaseCost>,
+    /// Peak resident memory of the whole run (Linux `VmHWM`), every case included.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_resident_bytes: Option<u64>,
 }
 
 impl Timing {
@@ -155,6 +167,12 @@ impl Timing {
             wall_seconds: 0.0,
             threads: 0,
             cases: self.cases.keys().map(|k| (k.clone(), 0.0)).collect(),
+            costs: self
+                .costs
+                .keys()
+                .map(|k| (k.clone(), CaseCost::default()))
+                .collect(),
+            peak_resident_bytes: None,
         }
     }
 }

@@ -7,6 +7,7 @@ mod compaction_reference_study;
 mod compaction_study;
 mod manufactured3d_study;
 mod manufactured_study;
+mod performance;
 mod study;
 mod three_d_studies;
 mod usability;

@@ -342,6 +342,9 @@ pub fn report_markdown(results: &ColumnResults) -> String {
             let _ = writeln!(s, "### {}\n\n![{}]({}.svg)\n", f.title, f.id, f.id);
         }
     }
-    s.push_str(&crate::render::performance_markdown(&results.cases));
+    s.push_str(&crate::render::performance_markdown(
+        &results.cases,
+        &results.timing,
+    ));
     s
 }
