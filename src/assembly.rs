@@ -238,6 +238,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         let mut local: Vec<f64> = Vec::new();
         let mut eq_buf: Vec<Option<usize>> = Vec::new();
         let mut sizes: Vec<usize> = Vec::new();
+        let mut groups: Vec<usize> = Vec::new();
         let threads = rayon::current_num_threads();
         for start in (0..n).step_by(CHUNK) {
             let end = (start + CHUNK).min(n);
@@ -318,15 +319,28 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                     }
                 }
             }
-            let (local, eq_buf, sizes) = (&local, &eq_buf, &sizes);
+            // Runs of consecutive points with the same equations (the Gauss points of one
+            // element, material points of one cell with the same support) are scattered
+            // once, their local matrices summed in point order first: one search and one
+            // update per entry per run instead of per point.
+            groups.clear();
+            for i in 0..len {
+                let eqs = &eq_buf[i * stride_eq..i * stride_eq + sizes[i]];
+                let same = i > 0 && eqs == &eq_buf[(i - 1) * stride_eq..(i - 1) * stride_eq + sizes[i - 1]];
+                if !same {
+                    groups.push(i);
+                }
+            }
+            groups.push(len);
+            let (local, eq_buf, sizes, groups) = (&local, &eq_buf, &sizes, &groups);
             self.matrix
                 .column_blocks(threads)
                 .into_par_iter()
                 .for_each(|mut block| {
-                    for i in 0..len {
-                        let md = sizes[i];
-                        let eqs = &eq_buf[i * stride_eq..i * stride_eq + md];
-                        let kl = &local[i * stride_k..];
+                    for g in groups.windows(2) {
+                        let (first, end) = (g[0], g[1]);
+                        let md = sizes[first];
+                        let eqs = &eq_buf[first * stride_eq..first * stride_eq + md];
                         for (ci, col) in eqs.iter().enumerate() {
                             let Some(col) = *col else { continue };
                             if !block.owns(col) {
@@ -335,7 +349,12 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                             let mut hint = usize::MAX;
                             for (ri, row) in eqs.iter().enumerate() {
                                 if let Some(row) = *row {
-                                    block.add_with_hint(row, col, kl[ri * md + ci], &mut hint);
+                                    let e = ri * md + ci;
+                                    let mut v = local[first * stride_k + e];
+                                    for i in first + 1..end {
+                                        v += local[i * stride_k + e];
+                                    }
+                                    block.add_with_hint(row, col, v, &mut hint);
                                 }
                             }
                         }

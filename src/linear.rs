@@ -110,6 +110,64 @@ pub struct SparseSystem {
     hierarchy: Option<(Box<crate::multigrid::Hierarchy>, usize)>,
     /// The LU factor of the last [`Self::factorize`] under [`LinearSolver::Lu`].
     lu: Option<Lu<usize, f64>>,
+    /// The row-compressed copy CG multiplies with, kept per pattern ([`CsrMirror`]).
+    mirror: Option<CsrMirror>,
+}
+
+/// The row-compressed copy of a column-compressed matrix, kept per pattern: its structure and
+/// where each entry sits in the column-compressed values (`from`) are built once, and each
+/// solve only gathers the current values, in parallel, into the same arrays: no transpose
+/// and no allocation of a matrix-sized buffer per solve (at 2e6 unknowns, 36e6 non-zeros:
+/// 0.6 s and 577 MB a solve before).
+#[derive(Debug)]
+struct CsrMirror {
+    csr: crate::multigrid::Csr,
+    from: Vec<u32>,
+}
+
+impl CsrMirror {
+    /// The mirror of an `n` × `n` pattern, or `None` if it has 2³² or more non-zeros.
+    fn of_pattern(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Option<Self> {
+        let nnz = row_idx.len();
+        u32::try_from(nnz).ok()?;
+        let mut ptr = vec![0usize; n + 1];
+        for &r in row_idx {
+            ptr[r + 1] += 1;
+        }
+        for i in 0..n {
+            ptr[i + 1] += ptr[i];
+        }
+        let mut next = ptr.clone();
+        let mut idx = vec![0usize; nnz];
+        let mut from = vec![0u32; nnz];
+        // Columns in order, so each row's column indices come out sorted.
+        for c in 0..n {
+            for k in col_ptr[c]..col_ptr[c + 1] {
+                let r = row_idx[k];
+                idx[next[r]] = c;
+                from[next[r]] = k as u32;
+                next[r] += 1;
+            }
+        }
+        let csr = crate::multigrid::Csr {
+            rows: n,
+            cols: n,
+            ptr,
+            idx,
+            val: vec![0.0; nnz],
+        };
+        Some(CsrMirror { csr, from })
+    }
+
+    /// Gather the current values.
+    fn refresh(&mut self, values: &[f64]) {
+        use rayon::prelude::*;
+        self.csr
+            .val
+            .par_iter_mut()
+            .zip(self.from.par_iter())
+            .for_each(|(v, &k)| *v = values[k as usize]);
+    }
 }
 
 /// A contiguous range of columns of a [`SparseSystem`] whose values one thread may update
@@ -208,6 +266,7 @@ impl SparseSystem {
         self.symbolic = None;
         self.symbolic_cholesky = None;
         self.hierarchy = None;
+        self.mirror = None;
     }
 
     /// Choose the factorisation (kept across [`Self::set_pattern`]).
@@ -328,20 +387,42 @@ impl SparseSystem {
     /// solve is then repeated with the fresh hierarchy. Reuse changes the preconditioner, not
     /// the system: every solve still reaches its tolerance on the current matrix.
     fn solve_cg(&mut self, b: &[f64], x: &mut [f64]) -> Result<(), String> {
+        let start = std::time::Instant::now();
+        if self.mirror.is_none() {
+            self.mirror = CsrMirror::of_pattern(self.n, &self.col_ptr, &self.row_idx);
+        }
+        let mirror = match self.mirror.take() {
+            Some(mut m) => {
+                m.refresh(&self.values);
+                m
+            }
+            // Too many non-zeros for the kept positions: a fresh transpose.
+            None => CsrMirror {
+                csr: self.to_csr(),
+                from: vec![],
+            },
+        };
+        self.stats.charge(crate::profile::Phase::Setup, start);
+        let out = self.solve_cg_with(&mirror.csr, b, x);
+        if !mirror.from.is_empty() {
+            self.mirror = Some(mirror);
+        }
+        out
+    }
+
+    /// [`Self::solve_cg`] with the current matrix in row-compressed form.
+    fn solve_cg_with(&mut self, a: &crate::multigrid::Csr, b: &[f64], x: &mut [f64]) -> Result<(), String> {
         use crate::multigrid::{gmres, pcg, Hierarchy};
         let rtol = if self.tolerance > 0.0 {
             self.tolerance
         } else {
             DEFAULT_ITERATIVE_TOLERANCE
         };
-        let start = std::time::Instant::now();
-        let a = self.to_csr();
-        self.stats.charge(crate::profile::Phase::Setup, start);
         if let Some((m, fresh)) = self.hierarchy.as_ref() {
             // Given up once it needs more than the fresh count allows.
             let allowed = (REUSE_FACTOR * *fresh as f64) as usize + 2;
             let start = std::time::Instant::now();
-            let report = pcg(&a, m, b, x, rtol, allowed);
+            let report = pcg(a, m, b, x, rtol, allowed);
             self.stats.charge(crate::profile::Phase::Solve, start);
             self.stats.iterations += report.as_ref().map_or(allowed, |r| r.iterations);
             match report {
@@ -355,17 +436,17 @@ impl SparseSystem {
             .ok_or("the CG solver needs the equations' positions (SparseSystem::set_geometry)")?;
         let start = std::time::Instant::now();
         self.hierarchy = None;
-        let m = Hierarchy::build(&a, geometry)?;
+        let m = Hierarchy::build(a, geometry)?;
         self.stats.charge(crate::profile::Phase::Setup, start);
         let start = std::time::Instant::now();
-        let report = pcg(&a, &m, b, x, rtol, MAX_CG_ITERATIONS);
+        let report = pcg(a, &m, b, x, rtol, MAX_CG_ITERATIONS);
         self.stats.charge(crate::profile::Phase::Solve, start);
         self.stats.iterations += report.as_ref().map_or(MAX_CG_ITERATIONS, |r| r.iterations);
         let report = match report {
             Ok(r) => r,
             Err(cg) => {
                 let start = std::time::Instant::now();
-                let report = gmres(&a, &m, b, x, rtol, MAX_GMRES_ITERATIONS);
+                let report = gmres(a, &m, b, x, rtol, MAX_GMRES_ITERATIONS);
                 self.stats.charge(crate::profile::Phase::Solve, start);
                 self.stats.gmres_solves += 1;
                 self.stats.iterations += report.as_ref().map_or(MAX_GMRES_ITERATIONS, |r| r.iterations);

@@ -1,7 +1,8 @@
 //! The Figure 17 reference study (`studies/compaction-reference.toml`), quick tier: its Q4
 //! FEM cases are solved by multigrid CG, and the Richardson reference they give equals the
 //! one the direct solver (LDLᵀ) gives on the same three meshes, to the Newton tolerance;
-//! every case converges, every load step quadratically.
+//! every case converges, every load step quadratically, and the CG iteration bound of the study
+//! file is evaluated and met.
 
 use igimp::fem::QuadElement;
 use igimp::linear::LinearSolver;
@@ -35,6 +36,14 @@ fn cg_reference_equals_the_direct_solvers_on_the_same_meshes() {
         fem.iter().all(|c| c.id.ends_with("-cg")),
         "the FEM cases are solved by CG"
     );
+    // The iteration bound of the study file, evaluated on the CG cases (h = 1/2 to 1/8 here).
+    let bound = r
+        .checks
+        .iter()
+        .find(|c| c.id == "fem-reference-cg-iterations")
+        .expect("the CG iteration check");
+    assert_eq!(bound.pass, Some(true), "{bound:?}");
+    assert!(bound.measured.unwrap() >= 1.0, "{bound:?}");
     let reference = r.measures.reference.as_ref().expect("a reference");
     // The same meshes by LDLᵀ (the compaction study's solver).
     let mut h: Vec<f64> = fem.iter().map(|c| c.h).collect();

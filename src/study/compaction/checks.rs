@@ -5,6 +5,7 @@
 use super::records::{CompactionRecord, CompactionResults, ReferenceRecord};
 use crate::method::Method;
 use crate::study::checks::{check_at_most, relative_spread, richardson, CheckRecord, GciRecord};
+use crate::study::results::CaseStatus;
 use crate::study::vocabulary::{number, points_grid};
 use std::collections::BTreeSet;
 
@@ -208,6 +209,26 @@ pub(super) fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
             ),
             if incomplete > 0 { Some(f64::INFINITY) } else { worst },
             e.tolerance,
+            &e.source,
+        ));
+    }
+    for e in &results.study.expect_linear_iterations {
+        // Σ CG iterations / Σ Newton solves of each converged case that used CG.
+        let worst = results
+            .sweep(&e.sweep)
+            .into_iter()
+            .filter(|c| c.status == CaseStatus::Converged)
+            .filter_map(|c| {
+                let cg: usize = c.steps.iter().map(|s| s.linear_iterations).sum();
+                let solves: usize = c.steps.iter().map(|s| s.residuals.len().saturating_sub(1)).sum();
+                (cg > 0 && solves > 0).then(|| cg as f64 / solves as f64)
+            })
+            .reduce(f64::max);
+        out.push(check_at_most(
+            &format!("{}-cg-iterations", e.sweep),
+            "largest mean number of CG iterations per Newton solve of a case solved by CG".into(),
+            worst,
+            e.max_per_solve,
             &e.source,
         ));
     }

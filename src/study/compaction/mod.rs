@@ -107,6 +107,16 @@ pub struct GhostSpreadExpectation {
     pub source: String,
 }
 
+/// The iterative solver stays O(n): every converged case of `sweep` solved by CG needs at
+/// most `max_per_solve` CG iterations per Newton solve on average over its load steps.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinearIterationsExpectation {
+    pub sweep: String,
+    pub max_per_solve: f64,
+    pub source: String,
+}
+
 /// The Figure 17 normalisation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -225,6 +235,9 @@ pub struct CompactionStudy {
     /// (and points per cell), for h ≤ `max_element_size`.
     #[serde(default)]
     pub expect_ghost_spread: Vec<GhostSpreadExpectation>,
+    /// CG iterations per Newton solve of a sweep's iterative cases.
+    #[serde(default)]
+    pub expect_linear_iterations: Vec<LinearIterationsExpectation>,
     #[serde(default)]
     pub paper_residuals: Vec<PaperResiduals>,
     #[serde(default)]

@@ -104,6 +104,16 @@ impl CompactionStudy {
         for (i, e) in self.expect_ghost_spread.iter().enumerate() {
             sweep_known(format!("expect_ghost_spread[{i}].sweep"), &e.sweep)?;
         }
+        for (i, e) in self.expect_linear_iterations.iter().enumerate() {
+            sweep_known(format!("expect_linear_iterations[{i}].sweep"), &e.sweep)?;
+            if !(e.max_per_solve >= 1.0 && e.max_per_solve.is_finite()) {
+                return Err(chk.err(
+                    format!("expect_linear_iterations[{i}].max_per_solve"),
+                    e.max_per_solve,
+                    "must be a finite number >= 1",
+                ));
+            }
+        }
         for (i, e) in self.expect_convergence.iter().enumerate() {
             sweep_known(format!("expect_convergence[{i}].sweep"), &e.sweep)?;
         }
