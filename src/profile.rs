@@ -189,6 +189,13 @@ pub fn run_case<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> (R, Ca
     CasePool::new(threads).run(f)
 }
 
+/// Reset this process's peak resident memory to its current size (Linux: `5` written to
+/// `/proc/self/clear_refs`), so that [`peak_resident_bytes`] measures from here; `false` if
+/// the system does not allow it.
+pub fn reset_peak_resident() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
 /// Peak resident memory of this process (Linux `VmHWM`), if the system reports it.
 pub fn peak_resident_bytes() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;

@@ -195,7 +195,7 @@ case's own (its largest live heap above what it started with).{}
 ",
         timing.threads,
         timing.peak_resident_bytes.map_or(String::new(), |b| format!(
-            " The whole run peaked at {:.0} MiB resident.",
+            " The study's run peaked at {:.0} MiB resident.",
             b as f64 / MIB
         ))
     );

@@ -351,6 +351,9 @@ pub fn run<K: StudyKind>(
     options: &RunOptions<'_>,
 ) -> Result<Run<K>, StudyError> {
     let start = Instant::now();
+    // The resident peak is the study's own only if it can be reset (one process may run
+    // several studies); otherwise it is not reported.
+    let own_peak = profile::reset_peak_resident();
     let (cases, sweep_cases) = study.cases(tier);
     let (solved, resumed) = solve_all(study, &cases, options)?;
     let mut times = std::collections::BTreeMap::new();
@@ -383,7 +386,8 @@ pub fn run<K: StudyKind>(
     };
     K::measure(&mut results);
     results.timing.wall_seconds = start.elapsed().as_secs_f64();
-    results.timing.peak_resident_bytes = profile::peak_resident_bytes();
+    // A run that read cases back from the store did not hold them: its peak is not theirs.
+    results.timing.peak_resident_bytes = profile::peak_resident_bytes().filter(|_| own_peak && resumed == 0);
     Ok(Run {
         results,
         outputs,

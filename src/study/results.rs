@@ -155,7 +155,8 @@ pub struct Timing {
     /// before they were accounted; a case resumed from such a store has its seconds only).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub costs: BTreeMap<String, CaseCost>,
-    /// Peak resident memory of the whole run (Linux `VmHWM`), every case included.
+    /// Peak resident memory of the study's run (Linux `VmHWM`, reset at its start), every
+    /// case included; absent where the peak cannot be reset or cases were resumed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub peak_resident_bytes: Option<u64>,
 }
