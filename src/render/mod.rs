@@ -195,7 +195,7 @@ case's own (its largest live heap above what it started with).{}
 ",
         timing.threads,
         timing.peak_resident_bytes.map_or(String::new(), |b| format!(
-            " The study's run peaked at {:.0} MiB resident.",
+            " The process peaked at {:.0} MiB resident during this study (memory the allocator kept from studies run before it in the same process included).",
             b as f64 / MIB
         ))
     );

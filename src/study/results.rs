@@ -155,8 +155,10 @@ pub struct Timing {
     /// before they were accounted; a case resumed from such a store has its seconds only).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub costs: BTreeMap<String, CaseCost>,
-    /// Peak resident memory of the study's run (Linux `VmHWM`, reset at its start), every
-    /// case included; absent where the peak cannot be reset or cases were resumed.
+    /// Peak resident memory of the process during the study's run (Linux `VmHWM`, reset at
+    /// its start to the resident size then, which includes what the allocator kept from
+    /// studies run before in the same process); absent where the peak cannot be reset or
+    /// cases were resumed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub peak_resident_bytes: Option<u64>,
 }
