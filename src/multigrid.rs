@@ -545,7 +545,7 @@ fn chebyshev(lv: &Level, b: &[f64], x: &mut [f64], r: &mut [f64], d: &mut [f64],
     }
 }
 
-/// uᵀv with a summation order fixed by [`CHUNK`] alone: partial sums of fixed chunks in
+/// uᵀv with a summation order fixed by `CHUNK` alone: partial sums of fixed chunks in
 /// parallel, added in order. (rayon's `sum` splits where work is stolen, so its result can
 /// change from run to run in the last bits, and CG at an indefinite iterate can then break
 /// down in one run and not in another.)
