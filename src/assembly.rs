@@ -89,10 +89,9 @@ impl<const D: usize> LoadStepSystem<'_, D> {
     /// Evaluate all points at the nodal increment and assemble the internal force (in
     /// equation order).
     pub fn assemble_residual(&mut self, f_int: &mut [f64]) -> Result<(), StepFailure> {
-        let start = std::time::Instant::now();
-        let out = self.assemble_residual_untimed(f_int);
-        crate::profile::charge(crate::profile::Phase::Constitutive, start);
-        out
+        crate::profile::timed(crate::profile::Phase::Constitutive, || {
+            self.assemble_residual_untimed(f_int)
+        })
     }
 
     fn assemble_residual_untimed(&mut self, f_int: &mut [f64]) -> Result<(), StepFailure> {
@@ -218,9 +217,9 @@ impl<const D: usize> LoadStepSystem<'_, D> {
     /// owned by one thread and filled in point order. Every entry thus receives its
     /// contributions in the same order whatever the thread count.
     pub fn assemble_tangent(&mut self) {
-        let start = std::time::Instant::now();
-        self.assemble_tangent_untimed();
-        crate::profile::charge(crate::profile::Phase::Assembly, start);
+        crate::profile::timed(crate::profile::Phase::Assembly, || {
+            self.assemble_tangent_untimed()
+        });
     }
 
     fn assemble_tangent_untimed(&mut self) {

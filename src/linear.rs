@@ -77,12 +77,20 @@ impl LinearStats {
     /// Add the wall time since `start` to `phase` (set-up or solve), here and in the case's
     /// profile ([`crate::profile`]).
     fn charge(&mut self, phase: crate::profile::Phase, start: std::time::Instant) {
-        let seconds = start.elapsed().as_secs_f64();
+        let seconds = crate::profile::charge(phase, start);
         match phase {
             crate::profile::Phase::Solve => self.solve_seconds += seconds,
             _ => self.setup_seconds += seconds,
         }
-        crate::profile::charge(phase, start);
+    }
+}
+
+/// `Ok` if every entry of a solution is finite, else the singular-tangent error.
+fn finite(x: &[f64]) -> Result<(), String> {
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err("the solution of the linear system is not finite (singular tangent)".into())
     }
 }
 
@@ -465,14 +473,7 @@ impl SparseSystem {
         match self.solver {
             LinearSolver::Ldlt | LinearSolver::Llt => self.factorize_symmetric(),
             LinearSolver::Lu => {
-                let n = self.n;
-                let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
-                if self.symbolic.is_none() {
-                    self.symbolic = Some(SymbolicLu::try_new(sym).map_err(|e| format!("{e:?}"))?);
-                }
-                let symbolic = self.symbolic.clone().expect("symbolic factorisation present");
-                let mat = SparseColMatRef::new(sym, &self.values);
-                self.lu = Some(Lu::try_new_with_symbolic(symbolic, mat).map_err(|e| format!("{e:?}"))?);
+                self.lu = Some(self.factor_lu()?);
                 Ok(())
             }
             LinearSolver::Cg => Err("factorize: a direct solver only (LDLᵀ, LLᵀ or LU)".into()),
@@ -488,11 +489,7 @@ impl SparseSystem {
             let lu = self.lu.as_ref().ok_or("solve_factorized: not factorised")?;
             let n = self.n;
             lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, 1));
-            return if rhs.iter().all(|v| v.is_finite()) {
-                Ok(())
-            } else {
-                Err("the solution of the linear system is not finite (singular tangent)".into())
-            };
+            return finite(rhs);
         }
         let symbolic = self
             .symbolic_cholesky
@@ -510,11 +507,7 @@ impl SparseSystem {
             }
             _ => LdltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, mat, par, stack),
         }
-        if rhs.iter().all(|v| v.is_finite()) {
-            Ok(())
-        } else {
-            Err("the solution of the linear system is not finite (singular tangent)".into())
-        }
+        finite(rhs)
     }
 
     /// Factorise (set-up) and solve (solve), LU when a symmetric factorisation fails.
@@ -530,22 +523,23 @@ impl SparseSystem {
             }
         }
         self.solve_lu(rhs)?;
-        if rhs.iter().all(|v| v.is_finite()) {
-            Ok(())
-        } else {
-            Err("the solution of the linear system is not finite (singular tangent)".into())
-        }
+        finite(rhs)
     }
 
-    fn solve_lu(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        let start = std::time::Instant::now();
+    /// LU of the current values, the symbolic analysis cached per pattern.
+    fn factor_lu(&mut self) -> Result<Lu<usize, f64>, String> {
         let sym = SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx);
         if self.symbolic.is_none() {
             self.symbolic = Some(SymbolicLu::try_new(sym).map_err(|e| format!("{e:?}"))?);
         }
         let symbolic = self.symbolic.clone().expect("symbolic factorisation present");
         let mat = SparseColMatRef::new(sym, &self.values);
-        let lu = Lu::try_new_with_symbolic(symbolic, mat).map_err(|e| format!("{e:?}"))?;
+        Lu::try_new_with_symbolic(symbolic, mat).map_err(|e| format!("{e:?}"))
+    }
+
+    fn solve_lu(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        let start = std::time::Instant::now();
+        let lu = self.factor_lu()?;
         self.stats.charge(crate::profile::Phase::Setup, start);
         let start = std::time::Instant::now();
         let n = self.n;

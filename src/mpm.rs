@@ -212,10 +212,7 @@ impl<const D: usize> MpmSolver<D> {
 
     /// Evaluate the weights of every point on the grid at the current positions and domains.
     pub fn build_supports(&mut self) -> Result<(), StepFailure> {
-        let start = std::time::Instant::now();
-        let out = self.build_supports_untimed();
-        crate::profile::charge(crate::profile::Phase::Weights, start);
-        out
+        crate::profile::timed(crate::profile::Phase::Weights, || self.build_supports_untimed())
     }
 
     fn build_supports_untimed(&mut self) -> Result<(), StepFailure> {

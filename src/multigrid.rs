@@ -566,6 +566,21 @@ pub struct CgReport {
     pub relative_residual: f64,
 }
 
+impl CgReport {
+    /// x = 0 solves b = 0.
+    const EXACT: CgReport = CgReport {
+        iterations: 0,
+        relative_residual: 0.0,
+    };
+}
+
+/// The start of a Krylov solve: x = 0, and ‖b‖ unless b = 0 (then x = 0 is the solution).
+fn zero_start(b: &[f64], x: &mut [f64]) -> Option<f64> {
+    x.iter_mut().for_each(|v| *v = 0.0);
+    let bnorm = dot(b, b).sqrt();
+    (bnorm != 0.0).then_some(bnorm)
+}
+
 /// Solve `A x = b` by CG preconditioned with `m`'s V-cycle (built for A or for an earlier
 /// matrix of the same pattern: any fixed symmetric positive definite preconditioner serves),
 /// from x = 0, until ‖b − A x‖ ≤ `rtol` ‖b‖ (Saad alg. 6.18). An error if `max_iterations`
@@ -580,14 +595,9 @@ pub fn pcg(
     max_iterations: usize,
 ) -> Result<CgReport, String> {
     let n = b.len();
-    x.iter_mut().for_each(|v| *v = 0.0);
-    let bnorm = dot(b, b).sqrt();
-    if bnorm == 0.0 {
-        return Ok(CgReport {
-            iterations: 0,
-            relative_residual: 0.0,
-        });
-    }
+    let Some(bnorm) = zero_start(b, x) else {
+        return Ok(CgReport::EXACT);
+    };
     let mut r = b.to_vec();
     let mut z = vec![0.0; n];
     m.apply(&r, &mut z)?;
@@ -649,14 +659,9 @@ pub fn gmres(
 ) -> Result<CgReport, String> {
     let n = b.len();
     let k = GMRES_RESTART;
-    x.iter_mut().for_each(|v| *v = 0.0);
-    let bnorm = dot(b, b).sqrt();
-    if bnorm == 0.0 {
-        return Ok(CgReport {
-            iterations: 0,
-            relative_residual: 0.0,
-        });
-    }
+    let Some(bnorm) = zero_start(b, x) else {
+        return Ok(CgReport::EXACT);
+    };
     let target = rtol * bnorm;
     let mut v: Vec<Vec<f64>> = (0..=k).map(|_| vec![0.0; n]).collect();
     let mut h = vec![[0.0; GMRES_RESTART]; GMRES_RESTART + 1];
@@ -733,10 +738,7 @@ pub fn gmres(
         m.apply(&w, &mut z)?;
         x.par_iter_mut().zip(z.par_iter()).for_each(|(xi, zi)| *xi += zi);
         // The true residual, so that rounding in the rotations cannot pass a wrong answer.
-        a.mul_vec(x, &mut w);
-        r.par_iter_mut()
-            .zip(b.par_iter().zip(w.par_iter()))
-            .for_each(|(ri, (bi, wi))| *ri = bi - wi);
+        a.residual(b, x, &mut r);
         beta = dot(&r, &r).sqrt();
         if !beta.is_finite() {
             return Err(format!("GMRES diverged at iteration {iterations}"));

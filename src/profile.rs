@@ -7,8 +7,7 @@
 //! charges each phase's wall time to the slot of the thread that ran it ([`charge`]), and the
 //! [`CountingAllocator`] — when a binary installs it as its global allocator — adds every
 //! allocation and release of a tagged thread to that slot's live bytes and high-water mark.
-//! Untagged threads (a library user's, a unit test's) charge slot 0, which nobody reads
-//! but [`untagged`].
+//! Untagged threads (a library user's, a unit test's) charge slot 0, which nobody reads.
 //!
 //! Times are wall-clock and vary from run to run (and with the cases that share the cores);
 //! they go to `results.json`'s `timing` block only, never into a case's record.
@@ -78,10 +77,13 @@ fn current_slot() -> usize {
     CURRENT.with(Cell::get)
 }
 
-/// Add the wall time since `start` to `phase` of the current thread's case.
-pub fn charge(phase: Phase, start: Instant) {
-    let nanos = u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX);
+/// Add the wall time since `start` to `phase` of the current thread's case; returns it in
+/// seconds.
+pub fn charge(phase: Phase, start: Instant) -> f64 {
+    let elapsed = start.elapsed();
+    let nanos = u64::try_from(elapsed.as_nanos()).unwrap_or(u64::MAX);
     TABLE[current_slot()].nanos[phase as usize].fetch_add(nanos, Relaxed);
+    elapsed.as_secs_f64()
 }
 
 /// Run `f` and charge its wall time to `phase`.
@@ -137,12 +139,6 @@ pub fn current() -> CaseCost {
     CaseCost::of_slot(current_slot(), 0.0)
 }
 
-/// The phases charged so far by untagged threads (benches and tests that call the solver
-/// directly), with `seconds` 0.
-pub fn untagged() -> CaseCost {
-    CaseCost::of_slot(0, 0.0)
-}
-
 /// A rayon pool whose threads carry a slot of their own: cases run on it one after another
 /// ([`CasePool::run`]) are accounted one by one, and nested parallel work stays on the pool,
 /// so a case's phases and allocations are its own even while other pools run other cases.
@@ -182,11 +178,6 @@ impl CasePool {
         };
         (r, CaseCost::of_slot(self.slot, start.elapsed().as_secs_f64()))
     }
-}
-
-/// Run `f` as one case on a [`CasePool`] of `threads` threads of its own.
-pub fn run_case<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> (R, CaseCost) {
-    CasePool::new(threads).run(f)
 }
 
 /// Reset this process's peak resident memory to its current size (Linux: `5` written to
@@ -268,7 +259,8 @@ mod tests {
 
     #[test]
     fn phases_charge_the_case_that_ran_them() {
-        let (_, a) = run_case(2, || {
+        let pool = CasePool::new(2);
+        let (_, a) = pool.run(|| {
             timed(Phase::Assembly, || {
                 std::thread::sleep(std::time::Duration::from_millis(20))
             });
@@ -287,7 +279,7 @@ mod tests {
         assert!(a.solve >= 0.03 && a.solve < 1.0, "{a:?}");
         assert_eq!(a.weights, 0.0);
         assert!(a.seconds >= a.assembly);
-        let (_, b) = run_case(1, || ());
-        assert_eq!(b.assembly, 0.0, "a new case starts from zero");
+        let (_, b) = pool.run(|| ());
+        assert_eq!(b.assembly, 0.0, "the pool's next case starts from zero");
     }
 }

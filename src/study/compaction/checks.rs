@@ -213,15 +213,14 @@ pub(super) fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
         ));
     }
     for e in &results.study.expect_linear_iterations {
-        // Σ CG iterations / Σ Newton solves of each converged case that used CG.
+        // Σ CG iterations / Newton solves of each converged case that used CG.
         let worst = results
             .sweep(&e.sweep)
             .into_iter()
             .filter(|c| c.status == CaseStatus::Converged)
             .filter_map(|c| {
                 let cg: usize = c.steps.iter().map(|s| s.linear_iterations).sum();
-                let solves: usize = c.steps.iter().map(|s| s.residuals.len().saturating_sub(1)).sum();
-                (cg > 0 && solves > 0).then(|| cg as f64 / solves as f64)
+                (cg > 0 && c.newton_iterations > 0).then(|| cg as f64 / c.newton_iterations as f64)
             })
             .reduce(f64::max);
         out.push(check_at_most(
