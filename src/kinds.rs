@@ -4,7 +4,7 @@
 //! (`src/problems/<x>.rs`), its study kind (`src/study/<x>/`), its render file
 //! (`src/render/<x>.rs`) and one line in [`KINDS`].
 
-use crate::render::{self, IndexEntry};
+use crate::render::{self, IndexEntry, Rendered};
 use crate::study::cantilever::CantileverStudy;
 use crate::study::column::StudySpec;
 use crate::study::compaction::CompactionStudy;
@@ -46,13 +46,13 @@ pub struct Kind {
     pub problem: &'static str,
     run: RunFn,
     catalogue: CatalogueFn,
-    render: fn(&Path) -> Result<Vec<PathBuf>, StudyError>,
+    render: fn(&Path) -> Result<Rendered, StudyError>,
     index: fn(&Path) -> Result<IndexEntry, StudyError>,
 }
 
 impl Kind {
     const fn of<K: StudyKind>(
-        render: fn(&Path) -> Result<Vec<PathBuf>, StudyError>,
+        render: fn(&Path) -> Result<Rendered, StudyError>,
         index: fn(&Path) -> Result<IndexEntry, StudyError>,
     ) -> Kind {
         Kind {
@@ -110,16 +110,10 @@ pub fn run_file(
     out: &Path,
     render_only: bool,
     options: RunOptions<'_>,
-) -> Result<(PathBuf, Option<RunSummary>, Vec<PathBuf>), StudyError> {
+) -> Result<(PathBuf, Option<RunSummary>, Rendered), StudyError> {
     let text = std::fs::read_to_string(file).map_err(|e| StudyError::io(file, e))?;
     let shown = file.display().to_string();
-    let problem = problem_of_study(&text).unwrap_or_default();
-    let k = kind(&problem, &shown).map_err(|e| {
-        match crate::study::vocabulary::parse_toml::<toml::Value>(&text, &shown) {
-            Err(parse) => parse,
-            Ok(_) => e,
-        }
-    })?;
+    let k = kind_of_study(&text, &shown)?;
     let file_name = file.file_name().map_or_else(
         || file.display().to_string(),
         |f| f.to_string_lossy().into_owned(),
@@ -137,19 +131,28 @@ pub fn run_file(
     Ok((dir, summary, files))
 }
 
-fn kind_of_results(dir: &Path) -> Result<&'static Kind, StudyError> {
-    let shown = dir.join("results.json").display().to_string();
-    match problem_of_results(dir) {
-        Some(p) => kind(&p, &shown),
-        None => Err(StudyError::io(
-            &dir.join("results.json"),
-            "missing or unreadable (no study.problem): solve the study first",
-        )),
-    }
+/// The kind of a study file's text: a TOML syntax error as the parser reports it, else its
+/// `problem` key's kind.
+fn kind_of_study(text: &str, shown: &str) -> Result<&'static Kind, StudyError> {
+    let problem = problem_of_study(text).unwrap_or_default();
+    kind(&problem, shown).map_err(|e| {
+        match crate::study::vocabulary::parse_toml::<toml::Value>(text, shown) {
+            Err(parse) => parse,
+            Ok(_) => e,
+        }
+    })
 }
 
-/// Render the tables and figures of a study folder from its results.
-pub fn render_dir(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+fn kind_of_results(dir: &Path) -> Result<&'static Kind, StudyError> {
+    // A replacement a killed run committed is finished before anything is read.
+    crate::study::replace::recover(dir)?;
+    let shown = dir.join("results.json").display().to_string();
+    kind(&problem_of_results(dir)?, &shown)
+}
+
+/// Render the tables and figures of a study folder from its results (and say which figures
+/// had nothing to draw).
+pub fn render_dir(dir: &Path) -> Result<Rendered, StudyError> {
     (kind_of_results(dir)?.render)(dir)
 }
 
@@ -180,6 +183,40 @@ pub fn render_index(out: &Path) -> Result<PathBuf, StudyError> {
 pub fn catalogue_entry(file: &Path) -> Result<(String, String), StudyError> {
     let text = std::fs::read_to_string(file).map_err(|e| StudyError::io(file, e))?;
     let shown = file.display().to_string();
-    let k = kind(&problem_of_study(&text).unwrap_or_default(), &shown)?;
+    let k = kind_of_study(&text, &shown)?;
     (k.catalogue)(&text, &shown)
+}
+
+/// Parse and validate every study file of a run, and reject two files with one `name` (they
+/// would write the same output folder): every error, or `Ok` if all are valid.
+pub fn validate_files(files: &[PathBuf]) -> Result<(), Vec<StudyError>> {
+    let mut errors = vec![];
+    let mut names: std::collections::BTreeMap<String, String> = Default::default();
+    for f in files {
+        match catalogue_entry(f) {
+            Ok((name, _)) => {
+                let shown = f.display().to_string();
+                if let Some(first) = names.get(&name) {
+                    if *first != shown {
+                        errors.push(StudyError::Invalid {
+                            file: shown,
+                            key: "name".into(),
+                            value: format!("{name:?}"),
+                            allowed: format!(
+                                "already the name of {first}: each study needs its own name (its output folder)"
+                            ),
+                        });
+                    }
+                } else {
+                    names.insert(name, shown);
+                }
+            }
+            Err(e) => errors.push(e),
+        }
+    }
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors)
+    }
 }

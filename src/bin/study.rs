@@ -57,11 +57,11 @@ struct Cli {
     /// compaction, cantilever and manufactured (2D and 3D), the material point domains
     /// (quadrilaterals in 2D, hexahedra in 3D) of the iGIMP and MPM cases with their
     /// background grid (FEM cases write none).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "render_only")]
     vtk: bool,
     /// With --vtk, also write every N-th load step (implies --vtk; column and cantilever;
     /// the compaction writes its initial and final states only, manufactured its final one).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..), conflicts_with = "render_only")]
     vtk_every: Option<u32>,
     /// Solve only shard K of N (0 <= K < N): the cases whose index in the deterministic case
     /// order is K mod N, stored in `<out>/<name>/cases/`; nothing is rendered. Run every
@@ -133,18 +133,85 @@ fn resolve(dir: &Path, name: &str) -> PathBuf {
     }
 }
 
-fn progress(n: u64) -> ProgressBar {
-    let bar = if std::io::stderr().is_terminal() {
-        ProgressBar::with_draw_target(Some(n), ProgressDrawTarget::stderr())
-    } else {
-        ProgressBar::hidden()
-    };
-    if let Ok(style) =
-        ProgressStyle::with_template("{prefix:>8} [{bar:40}] {pos}/{len} cases {elapsed} {msg}")
-    {
-        bar.set_style(style.progress_chars("=> "));
+/// Progress of one study's cases on stderr: a bar on a terminal; elsewhere (a Slurm log, a
+/// pipe) one plain line per finished case with the elapsed time and an estimate of the rest.
+/// A case that did not converge is printed as a line of its own in both, and counted in the
+/// bar's message.
+struct Progress {
+    label: String,
+    bar: ProgressBar,
+    terminal: bool,
+    start: Instant,
+    state: std::sync::Mutex<(usize, usize, usize)>,
+}
+
+impl Progress {
+    fn new(label: String) -> Self {
+        let terminal = std::io::stderr().is_terminal();
+        // Hidden until the number of cases is known, so no "0/0" frame is drawn.
+        let bar = ProgressBar::hidden();
+        if let Ok(style) =
+            ProgressStyle::with_template("{prefix:>8} [{bar:40}] {pos}/{len} cases {elapsed} {msg}")
+        {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        bar.set_prefix(label.clone());
+        Progress {
+            label,
+            bar,
+            terminal,
+            start: Instant::now(),
+            state: std::sync::Mutex::new((0, 0, 0)),
+        }
     }
-    bar
+
+    fn on_start(&self, n: usize) {
+        self.state.lock().unwrap_or_else(|e| e.into_inner()).0 = n;
+        self.bar.set_length(n as u64);
+        if self.terminal {
+            self.bar.set_draw_target(ProgressDrawTarget::stderr());
+        } else {
+            eprintln!("{}: {n} cases to solve or resume", self.label);
+        }
+    }
+
+    fn on_done(&self, id: &str, status: CaseStatus) {
+        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        s.1 += 1;
+        s.2 += usize::from(status != CaseStatus::Converged);
+        let (n, done, failed) = *s;
+        let elapsed = self.start.elapsed().as_secs_f64();
+        if self.terminal {
+            if status != CaseStatus::Converged {
+                self.bar
+                    .println(format!("{}: case {id} {}", self.label, status.word()));
+                self.bar.set_message(format!("({failed} not converged)"));
+            }
+            self.bar.inc(1);
+        } else {
+            // The cases left cost about what the finished ones did on average; crude, but the
+            // engine starts the most expensive first, so it errs long.
+            let eta = elapsed / done as f64 * n.saturating_sub(done) as f64;
+            eprintln!(
+                "{}: {done}/{n} cases, {id} {}, elapsed {}, ETA {}",
+                self.label,
+                status.word(),
+                clock(elapsed),
+                clock(eta)
+            );
+        }
+    }
+}
+
+/// Seconds as `1h02m03s`, `2m03s` or `3.4s`.
+fn clock(seconds: f64) -> String {
+    let s = seconds.max(0.0);
+    let whole = s.round() as u64;
+    match whole {
+        0..=59 => format!("{s:.1}s"),
+        60..=3599 => format!("{}m{:02}s", whole / 60, whole % 60),
+        _ => format!("{}h{:02}m{:02}s", whole / 3600, whole / 60 % 60, whole % 60),
+    }
 }
 
 /// Solve (unless `--render-only`) and render one study file; `Ok(false)` if a check failed
@@ -156,15 +223,9 @@ fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
         || file.display().to_string(),
         |s| s.to_string_lossy().into_owned(),
     );
-    let bar = progress(0);
-    bar.set_prefix(label.clone());
-    let on_start = |n: usize| bar.set_length(n as u64);
-    let on_done = |id: &str, status: CaseStatus| {
-        if status != CaseStatus::Converged {
-            bar.set_message(format!("{id} {status:?}"));
-        }
-        bar.inc(1);
-    };
+    let progress = Progress::new(label.clone());
+    let on_start = |n: usize| progress.on_start(n);
+    let on_done = |id: &str, status: CaseStatus| progress.on_done(id, status);
     let options = RunOptions {
         study_dir: None,
         resume: cli.resume,
@@ -176,12 +237,16 @@ fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
         on_done: &on_done,
     };
     let ran = kinds::run_file(file, tier, &cli.out, cli.render_only, options);
-    bar.finish_and_clear();
+    progress.bar.finish_and_clear();
     if let Err(e @ StudyError::ShardDone { .. }) = &ran {
         eprintln!("{label}: {e}");
         return Ok(true);
     }
-    let (dir, summary, files) = ran?;
+    let (dir, summary, rendered) = ran?;
+    let files = rendered.files;
+    for w in &rendered.not_drawn {
+        eprintln!("{label}: warning: {w}");
+    }
     let name = dir
         .file_name()
         .map_or(label, |n| n.to_string_lossy().into_owned());
@@ -267,6 +332,20 @@ fn main() -> ExitCode {
     } else {
         cli.studies.iter().map(|s| resolve(&dir, s)).collect()
     };
+    // Every file is checked before any is solved: a bad third file must not be found after
+    // the first two have run for an hour, and two files of one `name` would overwrite each
+    // other's output folder.
+    if let Err(errors) = kinds::validate_files(&files) {
+        for e in &errors {
+            eprintln!("error: {e}");
+        }
+        eprintln!(
+            "error: {} of {} study files invalid; nothing was solved",
+            errors.len(),
+            files.len()
+        );
+        return ExitCode::FAILURE;
+    }
     let mut all_ok = true;
     for f in &files {
         match run_one(f, &cli) {

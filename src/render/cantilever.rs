@@ -10,7 +10,7 @@ use crate::study::results::{read_json, read_results, CaseStatus};
 use crate::study::StudyError;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn f5(x: Option<f64>) -> String {
     x.map_or("—".into(), |v| format!("{v:.5}"))
@@ -29,7 +29,7 @@ fn case_label(study: &CantileverStudy, r: &CantileverRecord) -> String {
 }
 
 /// The main report.
-pub fn report_markdown(results: &CantileverResults) -> String {
+pub fn report_markdown(results: &CantileverResults, not_drawn: &[super::NotDrawn]) -> String {
     let study = &results.study;
     let (pass, fail, none) = check_counts(&results.checks);
     let mut s = format!(
@@ -148,6 +148,7 @@ pub fn report_markdown(results: &CantileverResults) -> String {
     ));
     s.push_str(&super::figures_markdown(
         study.figures.iter().map(|f| (f.title.as_str(), f.id.as_str())),
+        not_drawn,
     ));
     s
 }
@@ -271,15 +272,20 @@ fn render_figure(
 }
 
 /// Render the report and figures from `dir`'s `results.json` and `domains.json`.
-pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
     let results: Results = read_results(dir)?;
     let snapshots: BTreeMap<String, Vec<DomainSnapshot>> = read_json(&dir.join("domains.json"))?;
     let mut files = super::Files::new(dir);
-    files.text(&results.study.report_file, &report_markdown(&results))?;
     for f in &results.study.figures {
-        files.figure(&f.id, render_figure(&results, &snapshots, dir, f)?)?;
+        files.figure(
+            &f.id,
+            render_figure(&results, &snapshots, dir, f)?,
+            "no data (a domains figure of a case without domain snapshots, or no converged case to plot)",
+        )?;
     }
-    Ok(files.written)
+    let report = report_markdown(&results, &files.not_drawn);
+    files.report(&results.study.report_file, &report)?;
+    Ok(files.done())
 }
 
 pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
@@ -289,7 +295,10 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
         &r.checks,
         &r.study.report_file,
         std::iter::empty(),
-        r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
+        super::drawn(
+            dir,
+            r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
+        ),
     ))
 }
 

@@ -12,7 +12,7 @@ use crate::study::results::{read_json, read_results, CaseStatus};
 use crate::study::StudyError;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn e3(x: Option<f64>) -> String {
     x.map_or("—".into(), |v| format!("{v:.3e}"))
@@ -202,7 +202,7 @@ fn cases_table(results: &CompactionResults) -> String {
 }
 
 /// The main report.
-pub fn report_markdown(results: &CompactionResults) -> String {
+pub fn report_markdown(results: &CompactionResults, not_drawn: &[super::NotDrawn]) -> String {
     let spec = &results.study;
     let (pass, fail, none) = check_counts(&results.checks);
     let count = |st| results.cases.iter().filter(|c| c.status == st).count();
@@ -232,6 +232,7 @@ pub fn report_markdown(results: &CompactionResults) -> String {
     ));
     s.push_str(&super::figures_markdown(
         spec.figures.iter().map(|f| (f.title.as_str(), f.id.as_str())),
+        not_drawn,
     ));
     s
 }
@@ -405,18 +406,23 @@ type SeriesKey = (Method, Option<usize>);
 
 /// Render the report, the residual tables and the figures from `dir`'s `results.json` and
 /// `domains.json`. Returns the files written.
-pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
     let results: Results = read_results(dir)?;
     let domains: BTreeMap<String, Vec<DomainRecord>> = read_json(&dir.join("domains.json"))?;
     let mut files = super::Files::new(dir);
-    files.text(&results.study.report_file, &report_markdown(&results))?;
     for p in &results.study.paper_residuals {
         files.text(&p.file, &residual_table(&results, p))?;
     }
     for f in &results.study.figures {
-        files.figure(&f.id, render_figure(&results, &domains, dir, f)?)?;
+        files.figure(
+            &f.id,
+            render_figure(&results, &domains, dir, f)?,
+            "no data (no converged case among those it shows)",
+        )?;
     }
-    Ok(files.written)
+    let report = report_markdown(&results, &files.not_drawn);
+    files.report(&results.study.report_file, &report)?;
+    Ok(files.done())
 }
 
 pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
@@ -429,6 +435,9 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
             .paper_residuals
             .iter()
             .map(|p| (format!("{}: {}", p.table, p.title), p.file.clone())),
-        r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
+        super::drawn(
+            dir,
+            r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
+        ),
     ))
 }

@@ -12,7 +12,7 @@ use crate::study::results::{read_json, read_results};
 use crate::study::StudyError;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 type Results = ManufacturedResults;
 
@@ -35,7 +35,7 @@ fn pairwise(cases: &[&ManufacturedRecord], m: ErrorMeasure) -> Vec<Option<f64>> 
         .collect()
 }
 
-pub fn report_markdown(results: &Results) -> String {
+pub fn report_markdown(results: &Results, not_drawn: &[super::NotDrawn]) -> String {
     let study = &results.study;
     let (pass, fail, none) = check_counts(&results.checks);
     let mut s = format!(
@@ -135,6 +135,7 @@ pub fn report_markdown(results: &Results) -> String {
     ));
     s.push_str(&super::figures_markdown(
         study.figures.iter().map(|f| (f.title.as_str(), f.id.as_str())),
+        not_drawn,
     ));
     s
 }
@@ -211,15 +212,20 @@ fn render_figure(
 }
 
 /// Render the report and figures from `dir`'s `results.json` and `domains.json`.
-pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
     let results: Results = read_results(dir)?;
     let domains: BTreeMap<String, CasePoints> = read_json(&dir.join("domains.json"))?;
     let mut files = super::Files::new(dir);
-    files.text(&results.study.report_file, &report_markdown(&results))?;
     for f in &results.study.figures {
-        files.figure(&f.id, render_figure(&results, &domains, dir, f)?)?;
+        files.figure(
+            &f.id,
+            render_figure(&results, &domains, dir, f)?,
+            "no data (no converged case among those it shows)",
+        )?;
     }
-    Ok(files.written)
+    let report = report_markdown(&results, &files.not_drawn);
+    files.report(&results.study.report_file, &report)?;
+    Ok(files.done())
 }
 
 pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
@@ -229,6 +235,9 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
         &r.checks,
         &r.study.report_file,
         std::iter::empty(),
-        r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
+        super::drawn(
+            dir,
+            r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
+        ),
     ))
 }

@@ -33,17 +33,60 @@ pub fn index_page(entries: &[IndexEntry]) -> String {
     s
 }
 
-/// The `## Figures` section of a report: each figure's title and image (id.svg).
-pub(crate) fn figures_markdown<'a>(figures: impl IntoIterator<Item = (&'a str, &'a str)>) -> String {
+/// The `## Figures` section of a report: each figure's title and image (id.svg), or for a
+/// figure in `not_drawn` (nothing to draw) a line saying so instead of a link to no file.
+pub(crate) fn figures_markdown<'a>(
+    figures: impl IntoIterator<Item = (&'a str, &'a str)>,
+    not_drawn: &[NotDrawn],
+) -> String {
     let mut s = String::new();
     for (title, id) in figures {
-        let _ = writeln!(s, "### {title}\n\n![{id}]({id}.svg)\n");
+        match not_drawn.iter().find(|n| n.id == id) {
+            Some(n) => {
+                let _ = writeln!(s, "### {title}\n\n**Not drawn:** {}.\n", n.reason);
+            }
+            None => {
+                let _ = writeln!(s, "### {title}\n\n![{id}]({id}.svg)\n");
+            }
+        }
     }
     if s.is_empty() {
         s
     } else {
         format!("## Figures\n\n{s}")
     }
+}
+
+/// A figure of the study file that had nothing to draw (e.g. every case it shows failed, or a
+/// domains figure of a case without snapshots): a warning in the report and on stderr, never
+/// a failed study.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NotDrawn {
+    pub id: String,
+    pub reason: String,
+}
+
+impl std::fmt::Display for NotDrawn {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "figure `{}` not drawn: {}", self.id, self.reason)
+    }
+}
+
+/// What a renderer wrote and which figures it could not draw.
+#[derive(Debug, Clone, Default)]
+pub struct Rendered {
+    pub files: Vec<PathBuf>,
+    pub not_drawn: Vec<NotDrawn>,
+}
+
+/// The figure ids (and titles) of `figures` that were drawn: `<dir>/<id>.svg` exists.
+pub(crate) fn drawn<'a>(
+    dir: &'a Path,
+    figures: impl IntoIterator<Item = (String, String)> + 'a,
+) -> impl Iterator<Item = (String, String)> + 'a {
+    figures
+        .into_iter()
+        .filter(move |(_, id)| dir.join(format!("{id}.svg")).is_file())
 }
 
 /// The index header line of a study: its name, summary, tier and check counts.
@@ -55,15 +98,21 @@ fn index_header(name: &str, summary: &str, tier: Tier, checks: (usize, usize, us
     )
 }
 
-/// The files a renderer writes into a study folder, in order (atomically, each noted).
+/// The files a renderer writes into a study folder, in order (atomically, each noted), and
+/// the figures it could not draw.
 pub(crate) struct Files<'a> {
     dir: &'a Path,
     pub written: Vec<PathBuf>,
+    pub not_drawn: Vec<NotDrawn>,
 }
 
 impl<'a> Files<'a> {
     pub fn new(dir: &'a Path) -> Self {
-        Files { dir, written: vec![] }
+        Files {
+            dir,
+            written: vec![],
+            not_drawn: vec![],
+        }
     }
 
     /// A Markdown (or other text) file.
@@ -71,9 +120,40 @@ impl<'a> Files<'a> {
         write_text(&self.dir.join(file), text, &mut self.written)
     }
 
-    /// `<id>.svg`, if the figure has something to draw.
-    pub fn figure(&mut self, id: &str, svg: Option<String>) -> Result<(), StudyError> {
-        svg.map_or(Ok(()), |svg| self.text(&format!("{id}.svg"), &svg))
+    /// `<id>.svg` if the figure has something to draw; otherwise the figure is noted as not
+    /// drawn (with `reason`) and an `<id>.svg` of an earlier run is removed, so that nothing
+    /// links a figure of other results.
+    pub fn figure(&mut self, id: &str, svg: Option<String>, reason: &str) -> Result<(), StudyError> {
+        match svg {
+            Some(svg) => self.text(&format!("{id}.svg"), &svg),
+            None => {
+                let stale = self.dir.join(format!("{id}.svg"));
+                if stale.is_file() {
+                    std::fs::remove_file(&stale).map_err(|e| StudyError::io(&stale, e))?;
+                }
+                self.not_drawn.push(NotDrawn {
+                    id: id.to_string(),
+                    reason: reason.to_string(),
+                });
+                Ok(())
+            }
+        }
+    }
+
+    /// The report: written after the figures (it says which were not drawn) but listed first.
+    pub fn report(&mut self, file: &str, text: &str) -> Result<(), StudyError> {
+        self.text(file, text)?;
+        if let Some(p) = self.written.pop() {
+            self.written.insert(0, p);
+        }
+        Ok(())
+    }
+
+    pub fn done(self) -> Rendered {
+        Rendered {
+            files: self.written,
+            not_drawn: self.not_drawn,
+        }
     }
 }
 

@@ -400,13 +400,16 @@ pub fn run_in_memory<K: StudyKind>(study: &K, study_file: &str, tier: Tier) -> R
     run(study, study_file, tier, &RunOptions::default())
 }
 
-/// Write `<out>/<name>/results.json` and the kind's side files; returns the folder.
+/// Write `<out>/<name>/results.json` and the kind's side files, replacing the old ones as a
+/// whole ([`super::replace`]: a kill at any moment leaves the old report or the new one);
+/// returns the folder.
 pub fn write_outputs<K: StudyKind>(out: &Path, run: &Run<K>) -> Result<PathBuf, StudyError> {
     let study = &run.results.study;
     let dir = out.join(study.name());
-    std::fs::create_dir_all(&dir).map_err(|e| StudyError::io(&dir, e))?;
-    study.write_side_files(&dir, &run.outputs)?;
-    write_json(&dir.join("results.json"), &run.results, true)?;
+    let staged = super::replace::Staged::begin(&dir)?;
+    study.write_side_files(staged.dir(), &run.outputs)?;
+    write_json(&staged.dir().join("results.json"), &run.results, true)?;
+    staged.commit()?;
     Ok(dir)
 }
 

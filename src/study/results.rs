@@ -109,6 +109,38 @@ pub fn rejection(reason: impl Into<String>) -> FailureRecord {
 pub struct Software {
     pub name: String,
     pub version: String,
+    /// The git commit the binary was built from ("unknown" outside a checkout); absent in
+    /// results written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub commit: Option<String>,
+    /// Whether the sources the binary was built from (src/, Cargo.toml, Cargo.lock, build.rs)
+    /// differed from `commit`; absent where unknown.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dirty: Option<bool>,
+}
+
+impl Software {
+    /// This build: name, version, commit and dirty flag (build.rs).
+    pub fn this_build() -> Self {
+        Software {
+            name: env!("CARGO_PKG_NAME").to_string(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            commit: Some(env!("IGIMP_GIT_COMMIT").to_string()),
+            dirty: env!("IGIMP_GIT_DIRTY").parse().ok(),
+        }
+    }
+
+    /// `igimp 0.1.0, commit 507f631` (`, with uncommitted changes` when dirty).
+    pub fn label(&self) -> String {
+        let mut s = format!("{} {}", self.name, self.version);
+        if let Some(c) = &self.commit {
+            s.push_str(&format!(", commit {}", &c[..c.len().min(12)]));
+            if self.dirty == Some(true) {
+                s.push_str(" with uncommitted changes");
+            }
+        }
+        s
+    }
 }
 
 /// Header fields every `results.json` starts with.
@@ -123,10 +155,7 @@ pub struct Provenance {
 impl Provenance {
     pub fn new(study_file: &str, tier: Tier) -> Self {
         Provenance {
-            software: Software {
-                name: env!("CARGO_PKG_NAME").to_string(),
-                version: env!("CARGO_PKG_VERSION").to_string(),
-            },
+            software: Software::this_build(),
             study_file: study_file.to_string(),
             tier,
         }
@@ -135,9 +164,8 @@ impl Provenance {
     /// One line for the top of a report.
     pub fn line(&self) -> String {
         format!(
-            "Rendered from `results.json` by `study` ({} {}, {} tier, study file `{}`); regenerate, do not edit.",
-            self.software.name,
-            self.software.version,
+            "Rendered from `results.json` by `study` ({}, {} tier, study file `{}`); regenerate, do not edit.",
+            self.software.label(),
             self.tier.name(),
             self.study_file
         )
@@ -391,9 +419,29 @@ pub fn problem_of_study(text: &str) -> Option<String> {
     v.get("problem")?.as_str().map(str::to_string)
 }
 
-/// The `study.problem` recorded in `<dir>/results.json`, if readable.
-pub fn problem_of_results(dir: &Path) -> Option<String> {
-    let text = std::fs::read_to_string(dir.join("results.json")).ok()?;
-    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    v.get("study")?.get("problem")?.as_str().map(str::to_string)
+/// The `study.problem` recorded in `<dir>/results.json`; an error that says whether the file
+/// is missing, is not valid JSON (the parser's message, with line and column: e.g. a file
+/// truncated by a full disk) or lacks the key.
+pub fn problem_of_results(dir: &Path) -> Result<String, StudyError> {
+    let path = dir.join("results.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        let hint = if e.kind() == std::io::ErrorKind::NotFound {
+            ": solve the study first"
+        } else {
+            ""
+        };
+        StudyError::io(&path, format!("{e}{hint}"))
+    })?;
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| StudyError::Parse {
+        file: path.display().to_string(),
+        message: format!("not valid JSON ({e}); solve the study again to rewrite it"),
+    })?;
+    v.get("study")
+        .and_then(|s| s.get("problem"))
+        .and_then(|p| p.as_str())
+        .map(str::to_string)
+        .ok_or_else(|| StudyError::Parse {
+            file: path.display().to_string(),
+            message: "no `study.problem`: not the results.json of a study".into(),
+        })
 }

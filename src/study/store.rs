@@ -78,20 +78,12 @@ pub struct CaseStore {
 }
 
 impl CaseStore {
-    /// The store in `dir` (created if missing); temporary files left by a killed run are
-    /// removed.
+    /// The store in `dir` (created if missing); temporary files abandoned by a killed run
+    /// are removed, those of another live writer (a concurrent shard) are not
+    /// ([`crate::atomic_file::is_stale_temp`]).
     pub fn open(dir: &Path) -> Result<Self, StudyError> {
         std::fs::create_dir_all(dir).map_err(|e| StudyError::io(dir, e))?;
-        for entry in std::fs::read_dir(dir).map_err(|e| StudyError::io(dir, e))? {
-            let p = entry.map_err(|e| StudyError::io(dir, e))?.path();
-            let is_tmp = p.file_name().is_some_and(|n| {
-                let n = n.to_string_lossy();
-                n.starts_with('.') && n.ends_with(".tmp")
-            });
-            if is_tmp {
-                let _ = std::fs::remove_file(&p);
-            }
-        }
+        crate::atomic_file::remove_stale_temps(dir).map_err(|e| StudyError::io(dir, e))?;
         Ok(Self {
             dir: dir.to_path_buf(),
         })

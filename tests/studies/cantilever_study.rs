@@ -100,7 +100,7 @@ fn cantilever_quick_outputs_rerender_byte_identically_and_runs_repeat() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("reports");
     let dir = write_outputs(&out, quick()).unwrap();
-    let files = render(&dir).unwrap();
+    let files = render(&dir).unwrap().files;
     // serde_json may move a float by one ulp on the way back, so compare what the checks say.
     let parsed = read_results(&dir).unwrap();
     let verdicts = |c: &[igimp::study::checks::CheckRecord]| -> Vec<(String, Option<bool>)> {

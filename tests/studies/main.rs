@@ -8,6 +8,7 @@ mod compaction_study;
 mod manufactured3d_study;
 mod manufactured_study;
 mod performance;
+mod reliability;
 mod study;
 mod three_d_studies;
 mod usability;

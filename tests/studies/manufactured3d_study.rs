@@ -95,7 +95,7 @@ fn point_files_3d_reproduce_the_recorded_errors() {
 fn manufactured_3d_outputs_rerender_byte_identically() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = write_outputs(tmp.path(), quick()).unwrap();
-    let first = render(&dir).unwrap();
+    let first = render(&dir).unwrap().files;
     assert_eq!(first.len(), 5, "{first:?}");
     let report = std::fs::read_to_string(&first[0]).unwrap();
     assert!(
@@ -106,7 +106,7 @@ fn manufactured_3d_outputs_rerender_byte_identically() {
     for p in &first {
         std::fs::remove_file(p).unwrap();
     }
-    let again = render(&dir).unwrap();
+    let again = render(&dir).unwrap().files;
     assert_eq!(again, first);
     for (p, b) in again.iter().zip(bytes) {
         assert_eq!(std::fs::read(p).unwrap(), b, "{}", p.display());

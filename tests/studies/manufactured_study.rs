@@ -100,13 +100,13 @@ fn f_diagonal_equals_stretch_only_without_rotation() {
 fn manufactured_outputs_rerender_byte_identically() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = write_outputs(tmp.path(), quick()).unwrap();
-    let first = render(&dir).unwrap();
+    let first = render(&dir).unwrap().files;
     assert_eq!(first.len(), 7, "{first:?}");
     let bytes: Vec<Vec<u8>> = first.iter().map(|p| std::fs::read(p).unwrap()).collect();
     for p in &first {
         std::fs::remove_file(p).unwrap();
     }
-    let again = render(&dir).unwrap();
+    let again = render(&dir).unwrap().files;
     assert_eq!(again, first);
     for (p, b) in again.iter().zip(bytes) {
         assert_eq!(std::fs::read(p).unwrap(), b, "{}", p.display());

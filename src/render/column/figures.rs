@@ -9,7 +9,7 @@ pub fn render_figure(
     results: &ColumnResults,
     study_dir: &Path,
     fig: &FigureSpec,
-) -> Result<String, StudyError> {
+) -> Result<Option<String>, StudyError> {
     let ids = of_sweep(results, &fig.sweep);
     let file_err = |e: String| StudyError::Io {
         path: study_dir.join(format!("{}.svg", fig.id)).display().to_string(),
@@ -70,6 +70,7 @@ pub fn render_figure(
                 &series_out,
                 &curves,
             )
+            .map(Some)
             .map_err(file_err)
         }
         FigureKind::Convergence => {
@@ -89,7 +90,16 @@ pub fn render_figure(
                     slope: fitted(results, &fig.sweep, m, fig.weight, ppc, measure),
                 });
             }
-            plot::convergence_svg(&fig.title, measure.label(), &out, fig.slope_triangles).map_err(file_err)
+            // Nothing converged (or every error is zero): a log-log axis has nothing to show.
+            if !out
+                .iter()
+                .any(|s| s.points.iter().any(|p| p.0 > 0.0 && p.1 > 0.0))
+            {
+                return Ok(None);
+            }
+            plot::convergence_svg(&fig.title, measure.label(), &out, fig.slope_triangles)
+                .map(Some)
+                .map_err(file_err)
         }
     }
 }

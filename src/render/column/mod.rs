@@ -18,7 +18,7 @@ use crate::study::results::{read_results, CaseStatus};
 use crate::study::vocabulary::weight_label;
 use crate::study::StudyError;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 pub(super) fn series_label(m: Method, ppc: Option<usize>) -> String {
     match ppc {
@@ -113,14 +113,16 @@ pub(super) fn pass_word(p: Option<bool>) -> &'static str {
 
 /// Render the report and every figure of the column study in `dir` from its `results.json`.
 /// Returns the files written.
-pub fn render(dir: &Path) -> Result<Vec<PathBuf>, StudyError> {
+pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
     let results: ColumnResults = read_results(dir)?;
     let mut files = super::Files::new(dir);
-    files.text(&results.study.report_file, &report_markdown(&results))?;
     for f in &results.study.figures {
-        files.figure(&f.id, Some(render_figure(&results, dir, f)?))?;
+        let reason = "no positive error of a converged case to plot on log-log axes";
+        files.figure(&f.id, render_figure(&results, dir, f)?, reason)?;
     }
-    Ok(files.written)
+    let report = report_markdown(&results, &files.not_drawn);
+    files.report(&results.study.report_file, &report)?;
+    Ok(files.done())
 }
 
 /// The column study's section of `reports/index.md`: the report, the results and point
@@ -143,7 +145,11 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
     }
     s.push('\n');
     for f in &results.study.figures {
-        let _ = writeln!(s, "### {}\n\n![{}]({name}/{}.svg)\n", f.title, f.title, f.id);
+        if dir.join(format!("{}.svg", f.id)).is_file() {
+            let _ = writeln!(s, "### {}\n\n![{}]({name}/{}.svg)\n", f.title, f.title, f.id);
+        } else {
+            let _ = writeln!(s, "### {}\n\nNot drawn (no data): see the report.\n", f.title);
+        }
     }
     Ok(IndexEntry {
         markdown: s,

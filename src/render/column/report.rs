@@ -4,7 +4,7 @@
 use super::*;
 
 /// The Markdown report of one study.
-pub fn report_markdown(results: &ColumnResults) -> String {
+pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::render::NotDrawn]) -> String {
     let spec = &results.study;
     let mut s = String::new();
     let _ = writeln!(s, "# {}: {}\n", spec.name, spec.summary);
@@ -336,12 +336,10 @@ pub fn report_markdown(results: &ColumnResults) -> String {
         }
         s.push('\n');
     }
-    if !spec.figures.is_empty() {
-        let _ = writeln!(s, "## Figures\n");
-        for f in &spec.figures {
-            let _ = writeln!(s, "### {}\n\n![{}]({}.svg)\n", f.title, f.id, f.id);
-        }
-    }
+    s.push_str(&crate::render::figures_markdown(
+        spec.figures.iter().map(|f| (f.title.as_str(), f.id.as_str())),
+        not_drawn,
+    ));
     s.push_str(&crate::render::performance_markdown(
         &results.cases,
         &results.timing,
