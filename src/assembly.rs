@@ -395,10 +395,17 @@ impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
     fn reference_norm(&self, norm: ResidualNorm) -> f64 {
         let ext: f64 = self.f_ext.iter().map(|x| x * x).sum();
         match norm {
-            ResidualNorm::External => ext.sqrt(),
+            ResidualNorm::External => crate::norms::l2(self.f_ext),
             // ‖f_ext + f_reaction‖ over all dofs: f_ext at the free dofs and, at the fixed
             // ones, f_ext + reaction = f_int of the last evaluation.
-            ResidualNorm::Total => (ext + self.fixed_forces.iter().map(|x| x * x).sum::<f64>()).sqrt(),
+            ResidualNorm::Total => {
+                let sq = ext + self.fixed_forces.iter().map(|x| x * x).sum::<f64>();
+                if sq.is_normal() {
+                    sq.sqrt()
+                } else {
+                    crate::norms::l2_of(&[self.f_ext, self.fixed_forces])
+                }
+            }
             // f_ext + f_rct at the fixed dofs = f_int + f^ob there.
             ResidualNorm::Linearised => {
                 let fixed: f64 = match self.linearised.as_deref() {

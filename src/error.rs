@@ -19,10 +19,41 @@ impl InputError {
     pub fn new(field: impl Into<String>, value: impl ToString, allowed: impl Into<String>) -> Self {
         Self {
             field: field.into(),
-            value: value.to_string(),
-            allowed: allowed.into(),
+            value: tidy_numbers(&value.to_string()),
+            allowed: tidy_numbers(&allowed.into()),
         }
     }
+}
+
+/// Longest number written out in full in a message: longer ones (`Display` of 1e300 has 301
+/// digits) are rewritten in their shortest round-trip form (`1e300`, `1e-300`).
+const LONGEST_PLAIN_NUMBER: usize = 24;
+
+/// `text` with every number longer than [`LONGEST_PLAIN_NUMBER`] characters in shortest
+/// round-trip form, so that an extreme input gives a readable message.
+pub fn tidy_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut run = String::new();
+    let flush = |run: &mut String, out: &mut String| {
+        match run.parse::<f64>() {
+            Ok(v) if run.len() > LONGEST_PLAIN_NUMBER => {
+                let s = format!("{v:?}");
+                out.push_str(s.strip_suffix(".0").unwrap_or(&s));
+            }
+            _ => out.push_str(run),
+        }
+        run.clear();
+    };
+    for c in text.chars() {
+        if c.is_ascii_digit() || (c == '.' && !run.is_empty()) || (c == '-' && run.is_empty()) {
+            run.push(c);
+        } else {
+            flush(&mut run, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut run, &mut out);
+    out
 }
 
 /// Check that `value` is finite and strictly positive.
@@ -100,5 +131,26 @@ fn cut_note(attempts: usize, load_factor: f64) -> String {
         )
     } else {
         String::new()
+    }
+}
+
+#[cfg(test)]
+mod tidy_tests {
+    use super::tidy_numbers;
+
+    #[test]
+    fn long_numbers_are_shortened_and_short_ones_kept() {
+        let big = format!("{}", 1e300);
+        assert_eq!(tidy_numbers(&format!("must be <= {big}")), "must be <= 1e300");
+        let tiny = format!("{}", 1e-300);
+        assert_eq!(tidy_numbers(&format!("{tiny}, x")), "1e-300, x");
+        for kept in [
+            "elements[3] = 1.5",
+            "1-64 characters",
+            "h = 0.005649717514124294",
+            "a-b",
+        ] {
+            assert_eq!(tidy_numbers(kept), kept);
+        }
     }
 }

@@ -125,7 +125,8 @@ impl CantileverSpec {
         require_positive("element_size", self.element_size)?;
         require_positive("grid_below", self.grid_below)?;
         require_positive("grid_margin", self.grid_margin)?;
-        crate::error::require_finite("load", self.load)?;
+        // P acts downwards (along -y); a zero load has no elastica to compare with.
+        require_positive("load", self.load)?;
         crate::fem::validate_stepping(&self.newton, self.load_steps)?;
         require_count("points_per_cell", self.points_per_cell, 1)?;
         if self.points_per_cell > 16 {
@@ -160,11 +161,16 @@ impl CantileverSpec {
                 "points through the depth must be even so that two points straddle the neutral axis",
             ));
         }
-        if (self.depth / self.element_size).round() as usize % 2 != 0 {
+        let through = (self.depth / self.element_size).round() as usize;
+        if through % 2 != 0 {
             return Err(InputError::new(
-                "depth",
-                self.depth,
-                "must be an even number of elements so that the neutral axis is a grid line",
+                "element_size",
+                self.element_size,
+                format!(
+                    "must divide depth = {} into an even number of elements (it gives {through}) so that the neutral axis is a grid line: e.g. element_size = {}",
+                    self.depth,
+                    self.depth / (through + 1) as f64
+                ),
             ));
         }
         Ok(())

@@ -221,8 +221,30 @@ pub fn checks_markdown(checks: &[CheckRecord]) -> String {
 /// the converged steps. *Cost* (wall-clock, from `results.json`'s `timing`): each case's
 /// seconds by phase ([`crate::profile::Phase`]) and its heap peak. Both are empty for results
 /// written before they were recorded.
+/// The load steps accepted stalled at their round-off floor (above the tolerance, within
+/// [`crate::newton::FLOOR_ACCEPT_FACTOR`] of it), so that no such acceptance is silent; empty
+/// when there are none.
+fn floor_markdown<C: CaseRecordOf>(cases: &[C]) -> String {
+    let mut rows = String::new();
+    for c in cases {
+        for st in c.steps() {
+            if let Some(floor) = st.accepted_at_floor {
+                let last = st.residuals.last().copied().unwrap_or(f64::NAN);
+                let _ = writeln!(rows, "| {} | {} | {floor:.2e} | {last:.2e} |", c.id(), st.step);
+            }
+        }
+    }
+    if rows.is_empty() {
+        return rows;
+    }
+    format!(
+        "## Steps accepted at their round-off floor\n\nNewton used its iterations with the residual stalled above the tolerance at a floor within {} times it (`crate::newton::FLOOR_ACCEPT_FACTOR`, reference/README.md item 5); these steps count as converged.\n\n| case | step | floor | last residual |\n|---|---:|---:|---:|\n{rows}\n",
+        crate::newton::FLOOR_ACCEPT_FACTOR
+    )
+}
+
 pub fn performance_markdown<C: CaseRecordOf>(cases: &[C], timing: &Timing) -> String {
-    let mut s = String::new();
+    let mut s = floor_markdown(cases);
     if cases.iter().any(|c| c.steps().iter().any(|s| s.unknowns > 0)) {
         s.push_str(
             "## Linear systems

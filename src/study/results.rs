@@ -56,6 +56,10 @@ pub struct StepRecord {
     /// Conjugate-gradient iterations of the step's solves (0 for direct solves).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub linear_iterations: usize,
+    /// Accepted stalled at this estimated round-off floor, above the tolerance but within
+    /// [`crate::newton::FLOOR_ACCEPT_FACTOR`] of it (absent: the tolerance was met).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accepted_at_floor: Option<f64>,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -84,6 +88,7 @@ pub fn step_records(steps: &[StepReport]) -> Vec<StepRecord> {
             nonzeros: s.linear.nonzeros,
             factor_nonzeros: s.linear.factor_nonzeros,
             linear_iterations: s.linear.iterations,
+            accepted_at_floor: s.newton.accepted_floor,
         })
         .collect()
 }

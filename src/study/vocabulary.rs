@@ -136,13 +136,9 @@ pub fn max_points_per_axis(dim: u32) -> i64 {
         .unwrap_or(1)
 }
 
-/// Format a weight for case ids and labels without a trailing `.0`.
+/// Format a weight for case ids and labels: [`number`].
 pub fn weight_label(w: f64) -> String {
-    if w.fract() == 0.0 && w.abs() < 1e15 {
-        format!("{}", w as i64)
-    } else {
-        format!("{w}")
-    }
+    number(w)
 }
 
 /// A float as written in an error: scientific notation when very large or small.
@@ -154,9 +150,15 @@ pub fn short(v: f64) -> String {
     }
 }
 
-/// A number in a case id or label: shortest round-trip form.
+/// A number in a case id or label: the shortest text that reads back to the same float,
+/// without a trailing `.0` (`40000`, `0.25`, `1e300`, `1e-300`): Rust's `Display` writes
+/// every digit of 1e300, which made a 301-character file name of a case id.
 pub fn number(x: f64) -> String {
-    format!("{x}")
+    let s = format!("{x:?}");
+    match s.strip_suffix(".0") {
+        Some(t) => t.to_string(),
+        None => s,
+    }
 }
 
 /// Validation of one study file: every error names the file, the key, the value and the
@@ -172,12 +174,7 @@ impl Checker<'_> {
         value: impl ToString,
         allowed: impl Into<String>,
     ) -> StudyError {
-        StudyError::Invalid {
-            file: self.file.to_string(),
-            key: key.into(),
-            value: value.to_string(),
-            allowed: allowed.into(),
-        }
+        invalid(self.file, key, value, allowed)
     }
     pub fn count(&self, key: &str, v: i64, lo: i64, hi: i64) -> Result<(), StudyError> {
         if (lo..=hi).contains(&v) {
@@ -264,7 +261,30 @@ impl Checker<'_> {
         if !(n.tolerance.is_finite() && n.tolerance > 0.0 && n.tolerance < 1.0) {
             return Err(self.err(format!("{key}.tolerance"), n.tolerance, "must lie in (0, 1)"));
         }
-        self.count(&format!("{key}.max_iterations"), n.max_iterations, 1, 1000)
+        self.count(&format!("{key}.max_iterations"), n.max_iterations, 1, 1000)?;
+        if let Some(m) = n.max_cutbacks {
+            let max = crate::newton::MAX_CUTBACKS;
+            if m > max {
+                return Err(self.err(
+                    format!("{key}.max_cutbacks"),
+                    m,
+                    format!("must be an integer in 0..={max} (the smallest increment is 2^-max_cutbacks of a load step)"),
+                ));
+            }
+        }
+        Ok(())
+    }
+    /// A weak-node volume fraction: in [0, 1) (0 disables the treatment).
+    pub fn weak_node_tolerance(&self, key: &str, v: f64) -> Result<(), StudyError> {
+        if v.is_finite() && (0.0..1.0).contains(&v) {
+            Ok(())
+        } else {
+            Err(self.err(
+                key,
+                short(v),
+                "must lie in [0, 1) (a fraction of an element's volume; 0 = off)",
+            ))
+        }
     }
 }
 
@@ -288,8 +308,8 @@ pub fn invalid(
     StudyError::Invalid {
         file: file.to_string(),
         key: key.into(),
-        value: value.to_string(),
-        allowed: allowed.into(),
+        value: crate::error::tidy_numbers(&value.to_string()),
+        allowed: crate::error::tidy_numbers(&allowed.into()),
     }
 }
 
@@ -298,6 +318,18 @@ pub fn parse_toml<T: DeserializeOwned>(text: &str, file: &str) -> Result<T, Stud
     toml::from_str(text).map_err(|e| StudyError::Parse {
         file: file.to_string(),
         message: e.to_string().trim_end().to_string(),
+    })
+}
+
+/// Deserialize exactly two numbers (TOML's array into `[f64; 2]` would drop a third value
+/// silently): an error names the length found.
+pub fn exactly_two<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    let v: Vec<f64> = Vec::deserialize(d)?;
+    <[f64; 2]>::try_from(v.as_slice()).map_err(|_| {
+        serde::de::Error::invalid_length(
+            v.len(),
+            &"2 values (the horizontal extent and the height, in 2D and in 3D)",
+        )
     })
 }
 

@@ -5,6 +5,7 @@ mod cantilever_study;
 mod column3d_study;
 mod compaction_reference_study;
 mod compaction_study;
+mod defects;
 mod manufactured3d_study;
 mod manufactured_study;
 mod performance;

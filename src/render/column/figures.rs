@@ -76,19 +76,28 @@ pub fn render_figure(
         FigureKind::Convergence => {
             let measure = fig.measure.unwrap_or(Measure::StressError);
             let mut out = vec![];
-            for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {
-                let pts: Vec<(f64, f64)> = series(&results.cases, ids, m, fig.weight, ppc)
-                    .iter()
-                    .filter_map(|c| case_error(c, measure).map(|e| (c.elements as f64, e)))
-                    .collect();
-                if pts.is_empty() {
-                    continue;
+            for sweep in std::iter::once(&fig.sweep).chain(&fig.overlay) {
+                let ids = of_sweep(results, sweep);
+                let untreated = results.study.sweep(sweep).is_some_and(|s| s.untreated);
+                for (m, ppc) in sweep_series(results, sweep, fig.weight) {
+                    let pts: Vec<(f64, f64)> = series(&results.cases, ids, m, fig.weight, ppc)
+                        .iter()
+                        .filter_map(|c| case_error(c, measure).map(|e| (c.elements as f64, e)))
+                        .collect();
+                    if pts.is_empty() {
+                        continue;
+                    }
+                    let label = series_label(m, ppc);
+                    out.push(ConvergenceSeries {
+                        label: if untreated {
+                            format!("{label}, untreated")
+                        } else {
+                            label
+                        },
+                        points: pts,
+                        slope: fitted(results, sweep, m, fig.weight, ppc, measure),
+                    });
                 }
-                out.push(ConvergenceSeries {
-                    label: series_label(m, ppc),
-                    points: pts,
-                    slope: fitted(results, &fig.sweep, m, fig.weight, ppc, measure),
-                });
             }
             // Nothing converged (or every error is zero): a log-log axis has nothing to show.
             if !out

@@ -31,9 +31,13 @@ impl CantileverStudy {
             max_points_per_axis(dimension as u32),
         )?;
         chk.newton("newton", &self.newton)?;
+        chk.weak_node_tolerance("weak_nodes.tolerance", self.weak_nodes.tolerance)?;
         let mut ids = BTreeSet::new();
         for (i, c) in self.cases.iter().enumerate() {
             chk.unique_ident(&format!("cases[{i}].id"), &c.id, &mut ids)?;
+            if let Some(t) = c.weak_node_tolerance {
+                chk.weak_node_tolerance(&format!("cases[{i}].weak_node_tolerance"), t)?;
+            }
             c.method
                 .expect_one_of(
                     if dimension == 3 {
@@ -91,6 +95,13 @@ impl CantileverStudy {
         for (i, e) in self.expect_agreement.iter().enumerate() {
             known(format!("expect_agreement[{i}].case"), &e.case)?;
             known(format!("expect_agreement[{i}].reference"), &e.reference)?;
+            if e.reference == e.case {
+                return Err(chk.err(
+                    format!("expect_agreement[{i}].reference"),
+                    format!("{:?}", e.reference),
+                    "must name another case than `case` (a case always agrees with itself)",
+                ));
+            }
         }
         for (i, e) in self.expect_collapse.iter().enumerate() {
             known(format!("expect_collapse[{i}].case"), &e.case)?;
@@ -114,6 +125,20 @@ impl CantileverStudy {
                     f.cases.len(),
                     "domain figures draw exactly one case",
                 ));
+            }
+            if f.kind == CantileverFigureKind::Domains {
+                let takes = self
+                    .cases
+                    .iter()
+                    .find(|c| c.id == f.cases[0])
+                    .is_some_and(|c| c.snapshot_every > 0);
+                if !takes {
+                    return Err(chk.err(
+                        format!("figures[{i}].cases"),
+                        format!("{:?}", f.cases[0]),
+                        "a domains figure must draw a case that takes domain snapshots (set its snapshot_every > 0)",
+                    ));
+                }
             }
         }
         for (c, _) in self.all_cases() {

@@ -132,6 +132,11 @@ pub struct Sweep {
     pub newton: Option<NewtonSection>,
     #[serde(default)]
     pub quick: QuickOverrides,
+    /// Solve without the study's `[ghost]` penalty (the paper's untreated method, e.g. for
+    /// Figure 9 at one point per cell beside the stabilised series); cases it changes carry
+    /// `-untreated` in their ids.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub untreated: bool,
 }
 
 /// An expected convergence rate: the fitted slope of log(error) against log(h) of one series
@@ -209,6 +214,10 @@ pub struct FigureSpec {
     /// Draw a slope triangle at the fine end of each series (convergence figures).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub slope_triangles: bool,
+    /// Further sweeps whose series join the figure's (convergence figures), labelled
+    /// "untreated" where the sweep is.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub overlay: Vec<String>,
 }
 
 /// A study file.
@@ -283,6 +292,8 @@ pub struct SweepPlan {
     pub points_per_cell: Vec<usize>,
     pub load_steps: usize,
     pub newton: NewtonSettings,
+    /// The sweep's `untreated`.
+    pub untreated: bool,
 }
 
 impl StudySpec {
@@ -312,6 +323,7 @@ impl StudySpec {
             points_per_cell: pick(&sweep.points_per_cell, &q.points_per_cell),
             load_steps: sweep.load_steps.unwrap_or(self.load_steps) as usize,
             newton: sweep.newton.unwrap_or(self.newton).settings(),
+            untreated: sweep.untreated,
         })
     }
 
@@ -330,8 +342,8 @@ impl StudySpec {
             points_per_cell: ppc,
             load_steps: plan.load_steps,
             newton: plan.newton,
-            ghost: match (ppc, self.ghost) {
-                (1, Some(g)) => g.one_point_per_cell,
+            ghost: match (ppc, self.ghost, plan.untreated) {
+                (1, Some(g), false) => g.one_point_per_cell,
                 _ => crate::ghost::GhostSettings::default(),
             },
             dimension: self.dimension.max(1) as usize,
@@ -352,6 +364,13 @@ impl StudySpec {
             id.push_str(&format!("-p{p}"));
         }
         id.push_str(&format!("-s{}", spec.load_steps));
+        let treated = match (ppc, self.ghost) {
+            (Some(1), Some(g)) => g.one_point_per_cell,
+            _ => crate::ghost::GhostSettings::default(),
+        };
+        if spec.ghost != treated {
+            id.push_str("-untreated");
+        }
         if spec.newton != self.newton.settings() {
             id.push_str(&format!(
                 "-tol{:e}-it{}",

@@ -75,6 +75,21 @@ impl StudySpec {
             )?;
             if let Some(n) = s.fit_points {
                 c.count(&k("fit_points"), n, 2, 1000)?;
+                // A fit over more element counts than a tier runs would silently use fewer.
+                let quick = (!q.skip).then(|| q.elements.as_deref().unwrap_or(&s.elements));
+                for (tier, list) in [("", Some(&s.elements[..])), (" (quick tier)", quick)] {
+                    let distinct: BTreeSet<i64> = list.unwrap_or(&[]).iter().copied().collect();
+                    if list.is_some() && n as usize > distinct.len() {
+                        return Err(c.err(
+                            k("fit_points"),
+                            n,
+                            format!(
+                                "must be at most the {} element counts the sweep runs{tier}",
+                                distinct.len()
+                            ),
+                        ));
+                    }
+                }
             }
             if let Some(n) = s.load_steps {
                 c.count(&k("load_steps"), n, 1, 10_000)?;
@@ -154,6 +169,20 @@ impl StudySpec {
                     f.weight,
                     format!("must be a weight of sweep `{}`", sweep.id),
                 ));
+            }
+            for (j, o) in f.overlay.iter().enumerate() {
+                let key = k(&format!("overlay[{j}]"));
+                let other = self.sweep_ref(&c, &key, o)?;
+                if f.kind != FigureKind::Convergence || !other.weights.contains(&f.weight) || *o == f.sweep {
+                    return Err(c.err(
+                        key,
+                        format!("{o:?}"),
+                        format!(
+                            "must be another sweep with weight {} on a convergence figure",
+                            f.weight
+                        ),
+                    ));
+                }
             }
             match (f.kind, f.measure) {
                 (FigureKind::Convergence, None) => {

@@ -26,7 +26,9 @@ pub struct BlockSection {
     /// Half width of the block, the modelled half (the full block is twice as wide).
     pub half_width: f64,
     pub height: f64,
-    /// Background grid extent along x and y from the symmetry line / base.
+    /// Background grid extent along x and y from the symmetry line / base (in 3D: the
+    /// horizontal extent of both horizontal axes, and the height).
+    #[serde(deserialize_with = "crate::study::vocabulary::exactly_two")]
     pub grid_extent: [f64; 2],
     pub young_modulus: f64,
     pub poisson_ratio: f64,

@@ -30,6 +30,7 @@ impl CompactionStudy {
         }
         let dimension = self.block.dimension as usize;
         chk.newton("newton", &self.newton)?;
+        chk.weak_node_tolerance("weak_nodes.tolerance", self.weak_nodes.tolerance)?;
         self.ghost
             .validate()
             .map_err(|e| chk.err("ghost", e, "must be valid ghost settings"))?;

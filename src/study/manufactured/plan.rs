@@ -74,6 +74,19 @@ impl ManufacturedStudy {
                 };
                 chk.non_empty(&k("methods"), &plan.methods)?;
                 chk.non_empty(&k("cells"), &plan.cells)?;
+                let levels: BTreeSet<i64> = plan.cells.iter().copied().collect();
+                if let Some(n) = s.fit_points.filter(|&n| n as usize > levels.len()) {
+                    // A fit over more levels than the tier runs would silently use fewer.
+                    return Err(chk.err(
+                        format!("sweeps[{i}].fit_points"),
+                        n,
+                        format!(
+                            "must be at most the {} cell counts {} runs",
+                            levels.len(),
+                            k("cells")
+                        ),
+                    ));
+                }
                 chk.non_empty(&k("points_per_cell"), &plan.points_per_cell)?;
                 for (j, m) in plan.methods.iter().enumerate() {
                     m.expect_one_of(self.problem_name(), methods)
