@@ -4,7 +4,7 @@ use crate::assembly::{StepInput, StepWorkspace, SupportTable};
 use crate::basis::{Basis, Support};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, InputError, StepFailure};
-use crate::ghost::{cell_fill, GhostOperator, GhostSettings};
+use crate::ghost::{cell_fill, node_share, GhostOperator, GhostSettings};
 use crate::grid::Grid;
 use crate::kinematics::stretch_tensor;
 use crate::load_stepping::{Increment, LoadStepping};
@@ -267,6 +267,14 @@ impl<const D: usize> MpmSolver<D> {
                 &self.points.half_length,
                 self.points.state.iter().map(|s| s.volume),
                 self.ghost.fill_mut(),
+            );
+        }
+        if self.settings.ghost.is_on() && self.settings.ghost.cut_share > 0.0 {
+            node_share(
+                &self.grid,
+                &self.work.table,
+                self.points.state.iter().map(|s| s.volume),
+                self.ghost.share_mut(),
             );
         }
         self.ghost

@@ -108,6 +108,7 @@ impl Default for CantileverSpec {
                 gamma: 1e-2,
                 faces: GhostFaces::Cut,
                 cut_fill: 0.05,
+                cut_share: 0.0,
             },
             dimension: 2,
         }

@@ -70,6 +70,10 @@ pub struct GhostSection {
     /// [`crate::ghost::DEFAULT_CUT_FILL`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cut_fill: Option<f64>,
+    /// Node share below which a node's cells are cut too ([`crate::ghost::GhostSettings::cut_share`]);
+    /// default 0 (off).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cut_share: Option<f64>,
     /// Settings for one point per cell; default: the ones above.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub one_point_per_cell: Option<crate::ghost::GhostSettings>,
@@ -92,6 +96,7 @@ impl GhostSection {
                 gamma: self.gamma,
                 faces: self.faces,
                 cut_fill: self.cut_fill.unwrap_or(crate::ghost::DEFAULT_CUT_FILL),
+                cut_share: self.cut_share.unwrap_or(0.0),
             },
         };
         if let Some(gamma) = gamma {

@@ -197,6 +197,7 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
         gamma: 0.5,
         faces: GhostFaces::Cut,
         cut_fill: 0.6,
+        ..Default::default()
     };
     // (basis, ghost, upper corner of the material): [3.5, 2.5] leaves half-filled cells.
     let variants = [
