@@ -114,13 +114,15 @@ fn cantilever_3d_quick_tier_completes_beside_the_elastica_and_hex20() {
             .map(|c| (c.id.as_str(), c.status, &c.steps[..])),
         (1e-4, 1e-8, 100.0),
     );
+    // The ghost sensitivity at h = 0.5 exceeds the 2D band in 3D (0.51 % with cut_share,
+    // reference/README.md items 29 and 38): shown, not required; the study checks it at
+    // h = 0.25 in the full tier (0.17 %).
+    let u = |id: &str| r.case(id).unwrap().u_over_l.unwrap();
+    let spread = ((u("stretch-g0.001") - u("stretch-g0.1")) / u("stretch-g0.1")).abs();
+    assert!(spread > 2e-3 && spread < 1e-2, "{spread:e}");
     for c in &r.checks {
-        if c.id == "stretch-g0.001-vs-stretch-g0.1" {
-            // The ghost sensitivity exceeds the 2D band in 3D (0.33 % against 0.2 %,
-            // reference/README.md item 29): evaluated and reported as failing.
-            let m = c.measured.expect("both gamma cases converge");
-            assert!(m > 2e-3 && m < 1e-2, "{m:e}");
-            assert_eq!(c.pass, Some(false));
+        if c.id == "stretch-h0.25-g0.001-vs-stretch-h0.25-g0.1" {
+            assert_eq!(c.pass, None, "full-tier cases: not evaluated in the quick tier");
             continue;
         }
         assert_eq!(

@@ -74,6 +74,9 @@ pub struct CaseSection {
     /// Weak-node tolerance of this case (the tie/fix alternative); default: `[weak_nodes]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weak_node_tolerance: Option<f64>,
+    /// Element size of this case (a refinement of the beam); default: `beam.element_size`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub element_size: Option<f64>,
     /// Keep the domains every this many steps (and the last) for the figures; 0: none.
     #[serde(default)]
     pub snapshot_every: i64,

@@ -35,6 +35,9 @@ impl CantileverStudy {
         let mut ids = BTreeSet::new();
         for (i, c) in self.cases.iter().enumerate() {
             chk.unique_ident(&format!("cases[{i}].id"), &c.id, &mut ids)?;
+            if let Some(h) = c.element_size {
+                chk.positive(&format!("cases[{i}].element_size"), h)?;
+            }
             if let Some(t) = c.weak_node_tolerance {
                 chk.weak_node_tolerance(&format!("cases[{i}].weak_node_tolerance"), t)?;
             }
@@ -186,6 +189,7 @@ impl CantileverStudy {
                     volume_update: c.volume_update.unwrap_or(base.volume_update),
                     ghost: self.ghost.settings(base.points_per_cell, false, c.ghost_gamma),
                     weak_node_tolerance: c.weak_node_tolerance.unwrap_or(base.weak_node_tolerance),
+                    element_size: c.element_size.unwrap_or(base.element_size),
                     ..base
                 }
             },
