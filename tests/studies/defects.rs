@@ -93,7 +93,8 @@ fn a_third_grid_extent_is_an_error_not_dropped() {
     );
     let tmp = tempfile::tempdir().unwrap();
     let f = write(tmp.path(), "s.toml", &t);
-    let (o, err) = run(&[f.as_os_str(), "--render-only".as_ref()]);
+    let out = tmp.path().join("out");
+    let (o, err) = run(&[f.as_os_str(), "--render-only".as_ref(), "--out".as_ref(), out.as_os_str()]);
     assert!(
         !o.status.success() && err.contains("grid_extent") && err.contains("2 values"),
         "{err}"
@@ -155,8 +156,15 @@ fn the_cantilever_depth_message_names_element_size() {
 
 #[test]
 fn render_only_with_vtk_is_a_usage_error() {
+    let tmp = tempfile::tempdir().unwrap();
     for flag in ["--vtk", "--vtk-every=2"] {
-        let (o, err) = run(&["column".as_ref(), "--render-only".as_ref(), flag.as_ref()]);
+        let (o, err) = run(&[
+            "column".as_ref(),
+            "--render-only".as_ref(),
+            flag.as_ref(),
+            "--out".as_ref(),
+            tmp.path().as_os_str(),
+        ]);
         assert_eq!(o.status.code(), Some(2), "{flag}: {err}");
         assert!(err.contains("cannot be used with"), "{err}");
     }
