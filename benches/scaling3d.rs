@@ -1,4 +1,4 @@
-//! Scaling of one 3D Newton iteration of the compaction problem (issue 15: the quarter of the
+//! Scaling of one 3D Newton iteration of the compaction problem (the quarter of the
 //! 8 × 8 × 8 block, `CompactionSpec::mpm_solver_3d`) with the number of material points,
 //! split as `scaling2d` is: weights, constitutive (residual pass), tangent assembly,
 //! factorisation + solve (direct, the library's only solver so far), peak memory. One process

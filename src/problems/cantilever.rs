@@ -7,7 +7,7 @@
 //! end-most material points just above and just below the neutral axis, and applied over the
 //! load steps. The background grid extends below the beam far enough for the deflected shape.
 //!
-//! In 3D (`dimension = 3`, issue 15) the beam is `length × depth × depth` (a square section),
+//! In 3D (`dimension = 3`, reference/README.md items 29 and 38) the beam is `length × depth × depth` (a square section),
 //! x along the beam, y up, z across. The supports are those of 2D on the end face x = 0 (u_x = 0
 //! on every node, u_y = 0 along its neutral-axis line), plus u_z = 0 on the mid-plane
 //! z = depth / 2, which is exact by symmetry and removes the rigid motions across. The end

@@ -1,4 +1,4 @@
-//! The manufactured solutions of [`super::manufactured`] in 3D (issue 15): the unit cube is the
+//! The manufactured solutions of [`super::manufactured`] in 3D (reference/README.md item 31): the unit cube is the
 //! material, the background grid and the FEM mesh, rollers on all six faces.
 //!
 //! - **axis-aligned**: x_i = X_i + A sin πX_i on every axis, F diagonal;

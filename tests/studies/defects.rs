@@ -94,7 +94,12 @@ fn a_third_grid_extent_is_an_error_not_dropped() {
     let tmp = tempfile::tempdir().unwrap();
     let f = write(tmp.path(), "s.toml", &t);
     let out = tmp.path().join("out");
-    let (o, err) = run(&[f.as_os_str(), "--render-only".as_ref(), "--out".as_ref(), out.as_os_str()]);
+    let (o, err) = run(&[
+        f.as_os_str(),
+        "--render-only".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
     assert!(
         !o.status.success() && err.contains("grid_extent") && err.contains("2 values"),
         "{err}"

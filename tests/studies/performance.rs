@@ -1,4 +1,4 @@
-//! The performance figures of `results.json` (the scale issue): every step's unknowns and
+//! The performance figures of `results.json` (reference/README.md item 35): every step's unknowns and
 //! nnz(K) match the problem's size, counted here from the mesh and its supports without the
 //! solver's dof map or pattern, and every case's cost block (seconds by phase, heap peak) is
 //! present and consistent. The compaction's quick tier, run by the `study` binary (whose

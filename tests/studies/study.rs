@@ -420,7 +420,7 @@ measure = "stress_error"
     assert!(table.contains("failed") && table.contains(&failed.id), "{table}");
 }
 
-/// The plastic column study (issue 6) in its quick tier: every expected rate (σzz, σxx,
+/// The plastic column study in its quick tier: every expected rate (σzz, σxx,
 /// linear FEM) lies in its band from `studies/column-plastic.toml`, iGIMP stays below linear
 /// FEM, the point files carry σxx, and the yield height of the finest iGIMP case is within
 /// 0.25 element of the analytical (Kirchhoff-criterion) value — and not the paper's formula.

@@ -1,4 +1,4 @@
-//! The 3D studies of issue 15, quick tier: `studies/compaction-3d.toml` (the quarter block
+//! The 3D studies, quick tier: `studies/compaction-3d.toml` (the quarter block
 //! against the Richardson-extrapolated Hex8 reference) and `studies/cantilever-3d.toml` (the
 //! 10 × 1 × 1 beam against the elastica with EI = E d⁴/12 and Hex20). Every case converges,
 //! every load step of every case converges quadratically (from the recorded residuals), every

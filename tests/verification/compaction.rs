@@ -253,7 +253,7 @@ fn mpm_weights_solve_the_compaction_and_other_methods_are_named_errors() {
     assert!(e.allowed.contains("igimp, mpm, fem-q4, fem-q8"), "{e}");
 }
 
-/// The 3D quarter block (issue 15; symmetry planes x = 0, y = 0, base on rollers, h = 1,
+/// The 3D quarter block (reference/README.md item 26; symmetry planes x = 0, y = 0, base on rollers, h = 1,
 /// 2×2×2 points per cell, 1,024 points): every load step converges quadratically (3 Newton
 /// iterations, e.g. 5.6e-2, 1.2e-3, 4.3e-7, 6.0e-14 at step 20), and the corner displacement
 /// 0.452943 is within 0.05 % of the h = 1/2 run (8,192 points: 0.452841, measured 2026-12-01;

@@ -102,7 +102,7 @@ fn elastica_shooting_is_fourth_order() {
 }
 
 /// PL²/EI = 1. Bisshopp & Drucker (1945), as tabulated in Frisch-Fay, *Flexible Bars*, give a
-/// tip deflection of 0.3017 L (the value quoted in issue 8's brief); we reproduce it to the
+/// tip deflection of 0.3017 L (the classical elastica value); we reproduce it to the
 /// 4 printed digits (0.301721). The brief's other recollected values, horizontal 0.0566 L and
 /// end slope 0.4536 rad, are not reproduced by either method nor by mpmath: all give
 /// 0.056433 L and 0.461352 rad (26.43°), so they are not used. Full digits: mpmath.

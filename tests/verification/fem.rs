@@ -1,4 +1,4 @@
-//! Updated-Lagrangian FEM comparators (issue 4): quadrature, patch tests, tangent against
+//! Updated-Lagrangian FEM comparators: quadrature, patch tests, tangent against
 //! finite differences, Newton's quadratic convergence, Table 1 (linear FEM rows) and the
 //! Figure 11 convergence rates of the §5.1 column, with its exact sampling points.
 //!

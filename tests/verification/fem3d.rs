@@ -1,4 +1,4 @@
-//! The 3D updated-Lagrangian FEM comparator (issue 15): Hex8 and Hex20 shape functions, the
+//! The 3D updated-Lagrangian FEM comparator: Hex8 and Hex20 shape functions, the
 //! structured hexahedral mesh, a patch test for homogeneous finite deformation on distorted
 //! meshes, and the global tangent against central differences at a rotated (oblique axis),
 //! stretched, partly plastic state.

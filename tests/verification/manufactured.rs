@@ -202,7 +202,7 @@ fn exact_field_residual_converges() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// 3D (issue 15)
+// 3D (reference/README.md item 31)
 
 /// The 3D fields: F against automatic differentiation of the motion, σ against the library's
 /// stress update at that F, and b₀ against 4th-order central differences of P, at random

@@ -1,4 +1,4 @@
-//! Robustness without bias (issue 12): one point per cell with the ghost term on every face,
+//! Robustness without bias (reference/README.md items 15-21): one point per cell with the ghost term on every face,
 //! adaptive load stepping, and the Newton stall diagnosis.
 
 use igimp::error::StepFailure;
