@@ -25,6 +25,16 @@ impl InputError {
     }
 }
 
+/// The shortest text that reads back to the same float, without a trailing `.0` (`40000`,
+/// `0.25`, `1e300`, `1e-300`): Rust's `Display` writes every digit of 1e300.
+pub fn shortest(x: f64) -> String {
+    let s = format!("{x:?}");
+    match s.strip_suffix(".0") {
+        Some(t) => t.to_string(),
+        None => s,
+    }
+}
+
 /// Longest number written out in full in a message: longer ones (`Display` of 1e300 has 301
 /// digits) are rewritten in their shortest round-trip form (`1e300`, `1e-300`).
 const LONGEST_PLAIN_NUMBER: usize = 24;
@@ -36,10 +46,7 @@ pub fn tidy_numbers(text: &str) -> String {
     let mut run = String::new();
     let flush = |run: &mut String, out: &mut String| {
         match run.parse::<f64>() {
-            Ok(v) if run.len() > LONGEST_PLAIN_NUMBER => {
-                let s = format!("{v:?}");
-                out.push_str(s.strip_suffix(".0").unwrap_or(&s));
-            }
+            Ok(v) if run.len() > LONGEST_PLAIN_NUMBER => out.push_str(&shortest(v)),
             _ => out.push_str(run),
         }
         run.clear();

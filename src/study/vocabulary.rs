@@ -159,11 +159,7 @@ pub fn short(v: f64) -> String {
 /// without a trailing `.0` (`40000`, `0.25`, `1e300`, `1e-300`): Rust's `Display` writes
 /// every digit of 1e300, which made a 301-character file name of a case id.
 pub fn number(x: f64) -> String {
-    let s = format!("{x:?}");
-    match s.strip_suffix(".0") {
-        Some(t) => t.to_string(),
-        None => s,
-    }
+    crate::error::shortest(x)
 }
 
 /// Validation of one study file: every error names the file, the key, the value and the
