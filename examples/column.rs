@@ -25,7 +25,7 @@ fn main() {
             exact.lateral_stress(0.0)
         );
     }
-    for method in [Method::Igimp, Method::Mpm] {
+    for method in [Method::IGIMP, Method::MPM] {
         let t = std::time::Instant::now();
         match solve_column(&spec, method) {
             Ok(o) => {

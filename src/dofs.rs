@@ -6,9 +6,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-/// Most nodes one integration point may touch: [`crate::basis::MAX_AXIS_NODES`] per axis in 3D.
-pub const MAX_POINT_NODES: usize =
-    crate::basis::MAX_AXIS_NODES * crate::basis::MAX_AXIS_NODES * crate::basis::MAX_AXIS_NODES;
+pub use crate::basis::MAX_POINT_NODES;
 
 /// For every point: the nodes it touches, the weights S and gradients ∂S/∂X̃ on the
 /// start-of-step configuration. Stored flat (CSR-like) and refilled every load step.

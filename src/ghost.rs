@@ -42,12 +42,12 @@
 //! active cells, which also controls the odd–even (1D) and hourglass (2D) modes of one point
 //! per cell.
 
-use crate::basis::Basis;
+use crate::basis::BasisFamily;
 use crate::dofs::DofMap;
 use crate::error::InputError;
 use crate::grid::Grid;
 use crate::linear::SparseSystem;
-use nalgebra::SVector;
+use crate::particles::MaterialPoints;
 use serde::{Deserialize, Serialize};
 
 /// Default of [`GhostSettings::cut_fill`]: a cell is cut (partially filled) when its material
@@ -173,15 +173,15 @@ impl GhostSettings {
     }
 }
 
-/// Material volume fraction of every cell of `grid` (cell-major, axis 0 fastest): for GIMP
-/// the part of each domain Ω_p ∩ Ω inside the cell, weighted by V_p / |Ω_p ∩ Ω| so that a
-/// point contributes its volume; for MPM the point's volume in the cell that holds it.
+/// Material volume fraction of every cell of `grid` (cell-major, axis 0 fastest): for the
+/// families with a domain box ([`BasisFamily::fill_box`]: GIMP, CPDI's corner bounds) the part
+/// of each box cut to the grid (Ω_p ∩ Ω) inside the cell, weighted by V_p / |Ω_p ∩ Ω| so that
+/// a point contributes its volume; for the point-evaluated ones (MPM, B-splines) the point's
+/// volume in the cell that holds it.
 pub fn cell_fill<const D: usize>(
     grid: &Grid<D>,
-    basis: Basis,
-    positions: &[SVector<f64, D>],
-    half_lengths: &[SVector<f64, D>],
-    volumes: impl Iterator<Item = f64>,
+    family: &dyn BasisFamily<D>,
+    points: &MaterialPoints<D>,
     fill: &mut Vec<f64>,
 ) {
     let (o, h, c) = (grid.origin(), grid.spacing(), grid.cells());
@@ -193,26 +193,30 @@ pub fn cell_fill<const D: usize>(
     let mut first = [0usize; D];
     let mut len = [0usize; D];
     let mut overlap = [[0.0f64; MAX_CELLS]; D];
-    for ((x, r), v) in positions.iter().zip(half_lengths).zip(volumes) {
+    for p in 0..points.len() {
+        let view = points.view(p);
+        let v = points.state[p].volume;
+        let boxed = family.fill_box(&view);
+        let x = view.position;
         let mut measure = 1.0;
         for a in 0..D {
             let n = c[a];
-            let (lo, hi) = match basis {
-                Basis::Mpm => {
+            let (lo, hi) = match boxed {
+                None => {
                     let t = (x[a] - o[a]) / h[a];
                     let e = (t.floor().max(0.0) as usize).min(n - 1);
                     (e as f64 + 0.5, e as f64 + 0.5)
                 }
-                Basis::Gimp => (
-                    ((x[a] - r[a] - o[a]) / h[a]).max(0.0),
-                    ((x[a] + r[a] - o[a]) / h[a]).min(n as f64),
+                Some((b_lo, b_hi)) => (
+                    ((b_lo[a] - o[a]) / h[a]).max(0.0),
+                    ((b_hi[a] - o[a]) / h[a]).min(n as f64),
                 ),
             };
             let e_lo = (lo.floor().max(0.0) as usize).min(n - 1);
             let e_hi = ((hi.ceil().max(1.0) as usize) - 1).min(n - 1).max(e_lo);
             first[a] = e_lo;
             len[a] = (e_hi - e_lo + 1).min(MAX_CELLS);
-            if basis == Basis::Mpm || hi <= lo {
+            if boxed.is_none() || hi <= lo {
                 len[a] = 1;
                 overlap[a][0] = 1.0;
             } else {

@@ -1,30 +1,18 @@
 //! The implicit material point solver: load-step loop, Newton solve and commit (Figures 6–7).
 
 use crate::assembly::{StepInput, StepWorkspace, SupportTable};
-use crate::basis::{Basis, Support};
+use crate::basis::{Basis, BasisError, BasisFamily, PointSupport};
 use crate::constitutive::ConstitutiveModel;
 use crate::error::{require_count, InputError, StepFailure};
 use crate::ghost::{cell_fill, node_share, GhostOperator, GhostSettings};
 use crate::grid::Grid;
-use crate::kinematics::stretch_tensor;
 use crate::load_stepping::{Increment, LoadStepping};
 use crate::newton::NewtonSettings;
 use crate::particles::MaterialPoints;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
-/// How material point domains are updated at the end of a load step (§3.3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum DomainUpdate {
-    /// l_i = l_i0 U_ii with the right stretch tensor U = √(FᵀF), eq (39) (the paper's choice).
-    #[default]
-    Stretch,
-    /// l_i = l_i0 F_ii, eq (37) (cpGIMP); fails under large rotation.
-    FDiagonal,
-    /// Domains never change (uGIMP).
-    Fixed,
-}
+pub use crate::basis::DomainUpdate;
 
 /// Solver settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -173,6 +161,10 @@ impl<const D: usize> MpmSolver<D> {
                 ));
             }
         }
+        let mut points = points;
+        if settings.basis.family::<D>().needs_corners() {
+            points.track_corners();
+        }
         Ok(Self {
             grid,
             points,
@@ -192,14 +184,9 @@ impl<const D: usize> MpmSolver<D> {
     }
 
     /// The failure of a point whose weights cannot be formed at (x, h).
-    fn basis_failure(
-        p: usize,
-        x: &SVector<f64, D>,
-        h: &SVector<f64, D>,
-        e: crate::basis::BasisError,
-    ) -> StepFailure {
+    fn basis_failure(p: usize, x: &SVector<f64, D>, h: &SVector<f64, D>, e: BasisError) -> StepFailure {
         match e {
-            crate::basis::BasisError::DegenerateDomain { .. } => StepFailure::Kinematics {
+            BasisError::DegenerateDomain { .. } | BasisError::InvertedDomain => StepFailure::Kinematics {
                 point: p,
                 reason: format!("{e} (half-lengths {:?})", h.as_slice()),
             },
@@ -215,17 +202,23 @@ impl<const D: usize> MpmSolver<D> {
         crate::profile::timed(crate::profile::Phase::Weights, || self.build_supports_untimed())
     }
 
+    /// The basis family of the settings.
+    fn family(&self) -> &'static dyn BasisFamily<D> {
+        self.settings.basis.family::<D>()
+    }
+
     fn build_supports_untimed(&mut self) -> Result<(), StepFailure> {
-        let basis = self.settings.basis;
+        let family = self.family();
         self.work.table.clear();
-        let mut sup = Support::<D>::default();
+        let mut sup = PointSupport::<D>::default();
         for p in 0..self.points.len() {
-            let (x, h) = (&self.points.position[p], &self.points.half_length[p]);
-            basis
-                .evaluate(&self.grid, x, h, &mut sup)
-                .map_err(|e| Self::basis_failure(p, x, h, e))?;
+            family
+                .evaluate(&self.grid, &self.points.view(p), &mut sup)
+                .map_err(|e| {
+                    Self::basis_failure(p, &self.points.position[p], &self.points.half_length[p], e)
+                })?;
             for k in 0..sup.len() {
-                let (node, s, g) = sup.node(&self.grid, k);
+                let (node, s, g) = sup.node(k);
                 self.work.table.push_node(node, s, g);
             }
             self.work.table.finish_point();
@@ -260,14 +253,7 @@ impl<const D: usize> MpmSolver<D> {
     pub fn build_ghost(&mut self) {
         let start = std::time::Instant::now();
         if self.settings.ghost.is_on() {
-            cell_fill(
-                &self.grid,
-                self.settings.basis,
-                &self.points.position,
-                &self.points.half_length,
-                self.points.state.iter().map(|s| s.volume),
-                self.ghost.fill_mut(),
-            );
+            cell_fill(&self.grid, self.family(), &self.points, self.ghost.fill_mut());
         }
         if self.settings.ghost.is_on() && self.settings.ghost.cut_share > 0.0 {
             node_share(
@@ -358,25 +344,23 @@ impl<const D: usize> MpmSolver<D> {
 
     /// Domain half-lengths after committing F (eqs 37/39).
     fn updated_half_length(&self, p: usize, f: &nalgebra::Matrix3<f64>) -> SVector<f64, D> {
-        let r0 = self.points.half_length0[p];
-        match self.settings.domain_update {
-            DomainUpdate::Stretch => {
-                let u = stretch_tensor(f);
-                SVector::<f64, D>::from_fn(|a, _| r0[a] * u[(a, a)])
-            }
-            DomainUpdate::FDiagonal => SVector::<f64, D>::from_fn(|a, _| r0[a] * f[(a, a)]),
-            DomainUpdate::Fixed => r0,
-        }
+        self.settings
+            .domain_update
+            .half_length(&self.points.half_length0[p], f)
     }
 
     /// Commit the converged step: states, positions (x += Σ S Δu) and domains (eqs 37/39).
     /// A domain that would collapse (length ≤ 0) fails the increment before anything is
     /// committed, so that the load stepping can retry it with a smaller one.
     fn commit(&mut self) -> Result<(), StepFailure> {
-        let mut probe = Support::<D>::default();
+        let family = self.family();
+        let mut probe = PointSupport::<D>::default();
+        let corners_per_point = if family.needs_corners() { 1 << D } else { 0 };
+        let mut corners = [SVector::<f64, D>::zeros(); crate::basis::cpdi::MAX_CORNERS];
         for p in 0..self.points.len() {
             let trial = self.work.trials[p].as_ref().expect("converged trial");
-            let h = self.updated_half_length(p, &trial.committed().f);
+            let f = trial.committed().f;
+            let h = self.updated_half_length(p, &f);
             if let Some(a) = (0..D).find(|&a| !(h[a] > 0.0 && h[a].is_finite())) {
                 return Err(StepFailure::Kinematics {
                     point: p,
@@ -387,13 +371,25 @@ impl<const D: usize> MpmSolver<D> {
                 });
             }
             // Weights the next step could not form (a point leaving the grid, a domain longer
-            // than the basis allows) are caught here, before anything is committed, so that
-            // the increment can be cut; found at the next step's weights they would fail
-            // every retry from the already committed state.
+            // than the basis allows, a folded CPDI domain) are caught here, before anything is
+            // committed, so that the increment can be cut; found at the next step's weights
+            // they would fail every retry from the already committed state.
             let x = self.points.position[p] + self.work.table.interpolate(p, &self.work.du_nodal);
-            self.settings
-                .basis
-                .evaluate(&self.grid, &x, &h, &mut probe)
+            let c = &mut corners[..corners_per_point];
+            c.copy_from_slice(self.points.corners_of(p));
+            family
+                .update_corners(&self.grid, &self.work.du_nodal, c)
+                .map_err(|e| Self::basis_failure(p, &x, &h, e))?;
+            let view = crate::basis::PointView {
+                position: &x,
+                half_length: &h,
+                position0: &self.points.position0[p],
+                half_length0: &self.points.half_length0[p],
+                f: &f,
+                corners: c,
+            };
+            family
+                .evaluate(&self.grid, &view, &mut probe)
                 .map_err(|e| Self::basis_failure(p, &x, &h, e))?;
         }
         for p in 0..self.points.len() {
@@ -403,6 +399,12 @@ impl<const D: usize> MpmSolver<D> {
             let du = self.work.table.interpolate(p, &self.work.du_nodal);
             self.points.position[p] += du;
             self.points.half_length[p] = self.updated_half_length(p, &new_state.f);
+            if corners_per_point > 0 {
+                let c = &mut self.points.corners[p * corners_per_point..(p + 1) * corners_per_point];
+                family
+                    .update_corners(&self.grid, &self.work.du_nodal, c)
+                    .expect("corner update checked above");
+            }
             if self.settings.volume_update == VolumeUpdate::DomainProduct {
                 // The paper's V_p^n: the product of the domain lengths (unit out-of-plane).
                 let h = self.points.half_length[p];

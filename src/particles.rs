@@ -23,6 +23,9 @@ pub struct MaterialPoints<const D: usize> {
     pub mass: Vec<f64>,
     /// Committed F, current volume and constitutive state.
     pub state: Vec<PointState>,
+    /// Domain corners, 2^D per point (axis 0 fastest), for the families that track them
+    /// (CPDI); empty otherwise ([`Self::track_corners`]).
+    pub corners: Vec<SVector<f64, D>>,
 }
 
 impl<const D: usize> MaterialPoints<D> {
@@ -122,6 +125,35 @@ impl<const D: usize> MaterialPoints<D> {
             pts.push(x, half, density);
         }
         Ok(pts)
+    }
+
+    /// Start tracking domain corners: each point's box x ± r (idempotent).
+    pub fn track_corners(&mut self) {
+        if self.corners.len() == self.len() << D {
+            return;
+        }
+        self.corners.clear();
+        for p in 0..self.len() {
+            crate::basis::cpdi::box_corners(&self.position[p], &self.half_length[p], &mut self.corners);
+        }
+    }
+
+    /// The corners of point `p` (empty unless tracked).
+    pub fn corners_of(&self, p: usize) -> &[SVector<f64, D>] {
+        let n = 1 << D;
+        self.corners.get(p * n..(p + 1) * n).unwrap_or(&[])
+    }
+
+    /// What a basis family may read of point `p` ([`crate::basis::PointView`]).
+    pub fn view(&self, p: usize) -> crate::basis::PointView<'_, D> {
+        crate::basis::PointView {
+            position: &self.position[p],
+            half_length: &self.half_length[p],
+            position0: &self.position0[p],
+            half_length0: &self.half_length0[p],
+            f: &self.state[p].f,
+            corners: self.corners_of(p),
+        }
     }
 
     /// Displacement of point `p` since the start of the analysis.

@@ -25,6 +25,13 @@ pub enum Bug {
     /// Multigrid prolongation with the two weights along each axis swapped (t for the lower
     /// node, 1 − t for the upper): a fine node on a coarse node draws on its neighbour.
     SwappedProlongation = 5,
+    /// B-splines without their boundary treatment: the weights of nodes beyond the grid
+    /// dropped instead of folded back by linear extrapolation.
+    SplineWithoutBoundary = 6,
+    /// CPDI corners moved against the grid: x_α − Σ N_v(x_α) Δu_v.
+    CornersAgainstGrid = 7,
+    /// TLMPM with the reference gradients ∇₀S used as the start-of-step ones (no Fₙ⁻ᵀ).
+    ReferenceGradients = 8,
 }
 
 static ACTIVE: AtomicU8 = AtomicU8::new(0);

@@ -48,7 +48,7 @@ fn newton_order() -> Result<f64, String> {
         cells: 8,
         ..ManufacturedSpec::default()
     };
-    let o = solve(&spec, Method::Igimp).map_err(|e| e.to_string())?;
+    let o = solve(&spec, Method::IGIMP).map_err(|e| e.to_string())?;
     if let Some(f) = o.failure {
         return Err(f.to_string());
     }
@@ -71,7 +71,7 @@ fn stress_rate(at_current: bool) -> f64 {
             cells: n,
             ..ManufacturedSpec::default()
         };
-        let o = solve(&spec, Method::Igimp).unwrap();
+        let o = solve(&spec, Method::IGIMP).unwrap();
         let exact = Exact::of(&spec);
         let pts: Vec<PointValue> = o
             .points

@@ -178,9 +178,9 @@ impl CantileverSpec {
     }
 
     /// Solver settings of the material point beam (2D or 3D).
-    fn mpm_settings(&self) -> MpmSettings {
+    fn mpm_settings(&self, basis: Basis) -> MpmSettings {
         MpmSettings {
-            basis: Basis::Gimp,
+            basis,
             domain_update: self.domain_update,
             newton: self.newton,
             load_steps: self.load_steps,
@@ -217,6 +217,11 @@ impl CantileverSpec {
     /// The plane-strain solver, and the indices of the two loaded points (below, above the
     /// neutral axis).
     pub fn mpm_solver(&self) -> Result<(MpmSolver<2>, [usize; 2]), InputError> {
+        self.mpm_solver_with(Basis::Gimp)
+    }
+
+    /// [`Self::mpm_solver`] with the basis family `basis`.
+    pub fn mpm_solver_with(&self, basis: Basis) -> Result<(MpmSolver<2>, [usize; 2]), InputError> {
         self.validate()?;
         let h = self.element_size;
         let grid = self.grid_2d()?;
@@ -240,7 +245,7 @@ impl CantileverSpec {
         };
         let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
         Ok((
-            MpmSolver::try_new(grid, points, model, fixed, loads, self.mpm_settings())?,
+            MpmSolver::try_new(grid, points, model, fixed, loads, self.mpm_settings(basis))?,
             loaded,
         ))
     }
@@ -248,6 +253,11 @@ impl CantileverSpec {
     /// The 3D solver (module docs), and the loaded points: the end-most points of the two rows
     /// straddling the neutral axis, across the width, in order of (y, z).
     pub fn mpm_solver_3d(&self) -> Result<(MpmSolver<3>, Vec<usize>), InputError> {
+        self.mpm_solver_3d_with(Basis::Gimp)
+    }
+
+    /// [`Self::mpm_solver_3d`] with the basis family `basis`.
+    pub fn mpm_solver_3d_with(&self, basis: Basis) -> Result<(MpmSolver<3>, Vec<usize>), InputError> {
         self.validate()?;
         let h = self.element_size;
         let grid = self.grid_3d()?;
@@ -272,7 +282,7 @@ impl CantileverSpec {
         };
         let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
         Ok((
-            MpmSolver::try_new(grid, points, model, fixed, loads, self.mpm_settings())?,
+            MpmSolver::try_new(grid, points, model, fixed, loads, self.mpm_settings(basis))?,
             loaded,
         ))
     }
@@ -387,8 +397,17 @@ fn snapshot<const D: usize>(solver: &MpmSolver<D>, shown: &[usize], step: usize)
 /// Run the cantilever with iGIMP (2D or 3D by `spec.dimension`), recording the end
 /// displacement after every step.
 pub fn solve_mpm(spec: &CantileverSpec, snapshot_every: usize) -> Result<CantileverOutcome, InputError> {
+    solve_mpm_with(spec, Basis::Gimp, snapshot_every)
+}
+
+/// [`solve_mpm`] with the basis family `basis`.
+pub fn solve_mpm_with(
+    spec: &CantileverSpec,
+    basis: Basis,
+    snapshot_every: usize,
+) -> Result<CantileverOutcome, InputError> {
     if spec.dimension == 3 {
-        let (solver, loaded) = spec.mpm_solver_3d()?;
+        let (solver, loaded) = spec.mpm_solver_3d_with(basis)?;
         // The layer just below the mid-plane z = d/2.
         let p0 = &solver.points.position0;
         let mid = 0.5 * spec.depth;
@@ -400,7 +419,7 @@ pub fn solve_mpm(spec: &CantileverSpec, snapshot_every: usize) -> Result<Cantile
         let shown: Vec<usize> = (0..p0.len()).filter(|&p| (p0[p][2] - z).abs() < 1e-12).collect();
         run_mpm(spec, solver, &loaded, shown, snapshot_every)
     } else {
-        let (solver, loaded) = spec.mpm_solver()?;
+        let (solver, loaded) = spec.mpm_solver_with(basis)?;
         let shown = (0..solver.points.len()).collect();
         run_mpm(spec, solver, &loaded, shown, snapshot_every)
     }
@@ -610,10 +629,27 @@ fn run_fem<const D: usize, E: ElementFamily<D>>(
 }
 
 /// The methods that solve the plane-strain cantilever.
-pub const METHODS: [Method; 2] = [Method::Igimp, Method::FemQ8];
+pub const METHODS: [Method; 7] = [
+    Method::IGIMP,
+    Method::MPM,
+    Method::CPDI,
+    Method::BSPLINE2,
+    Method::BSPLINE3,
+    Method::TLMPM,
+    Method::FEM_Q8,
+];
 
 /// The methods that solve the 3D cantilever.
-pub const METHODS_3D: [Method; 3] = [Method::Igimp, Method::FemHex8, Method::FemHex20];
+pub const METHODS_3D: [Method; 8] = [
+    Method::IGIMP,
+    Method::MPM,
+    Method::CPDI,
+    Method::BSPLINE2,
+    Method::BSPLINE3,
+    Method::TLMPM,
+    Method::FEM_HEX8,
+    Method::FEM_HEX20,
+];
 
 /// The methods of a cantilever in `dimension` (2 or 3).
 pub fn methods(dimension: usize) -> &'static [Method] {
@@ -657,18 +693,20 @@ pub fn solve(
         solid_snapshots: vec![],
     };
     match (method, spec.dimension) {
-        (Method::Igimp, _) => solve_mpm(spec, snapshot_every).map(|o| CantileverSolution {
-            steps: o.steps,
-            end: o.end,
-            failure: o.failure,
-            snapshots: o.snapshots,
-            min_half_length: o.min_half_length,
-            loaded_points: Some(o.loaded_points),
-            solid_snapshots: o.solid_snapshots,
-        }),
-        (Method::FemQ8, 2) => solve_fem_q8(spec).map(fem),
-        (Method::FemHex8, 3) => solve_fem_3d(spec, HexElement::Hex8).map(fem),
-        (Method::FemHex20, 3) => solve_fem_3d(spec, HexElement::Hex20).map(fem),
+        (Method::MaterialPoint(basis), _) => {
+            solve_mpm_with(spec, basis, snapshot_every).map(|o| CantileverSolution {
+                steps: o.steps,
+                end: o.end,
+                failure: o.failure,
+                snapshots: o.snapshots,
+                min_half_length: o.min_half_length,
+                loaded_points: Some(o.loaded_points),
+                solid_snapshots: o.solid_snapshots,
+            })
+        }
+        (Method::FEM_Q8, 2) => solve_fem_q8(spec).map(fem),
+        (Method::FEM_HEX8, 3) => solve_fem_3d(spec, HexElement::Hex8).map(fem),
+        (Method::FEM_HEX20, 3) => solve_fem_3d(spec, HexElement::Hex20).map(fem),
         _ => Err(method.unsupported(
             if spec.dimension == 3 {
                 "3D cantilever (dimension = 3)"

@@ -253,15 +253,28 @@ pub fn f_from_cauchy_stress(s: f64) -> f64 {
 pub use crate::method::Method;
 
 /// The methods that solve the column.
-pub const METHODS: [Method; 4] = [
-    Method::Mpm,
-    Method::Igimp,
-    Method::FemLinear,
-    Method::FemQuadratic,
+pub const METHODS: [Method; 8] = [
+    Method::MPM,
+    Method::IGIMP,
+    Method::CPDI,
+    Method::BSPLINE2,
+    Method::BSPLINE3,
+    Method::TLMPM,
+    Method::FEM_LINEAR,
+    Method::FEM_QUADRATIC,
 ];
 
 /// The methods that solve the 3D column (`dimension = 3`).
-pub const METHODS_3D: [Method; 4] = [Method::Mpm, Method::Igimp, Method::FemHex8, Method::FemHex20];
+pub const METHODS_3D: [Method; 8] = [
+    Method::MPM,
+    Method::IGIMP,
+    Method::CPDI,
+    Method::BSPLINE2,
+    Method::BSPLINE3,
+    Method::TLMPM,
+    Method::FEM_HEX8,
+    Method::FEM_HEX20,
+];
 
 /// The column problem's parameters (defaults: §5.1 with W = 40,000).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -595,10 +608,9 @@ pub fn solve_column_observed(
     observer: &mut ColumnObserver<'_>,
 ) -> Result<ColumnOutcome, InputError> {
     match (method, spec.dimension) {
-        (Method::Mpm, 3) => solve_mpm_3d(spec, Basis::Mpm, observer),
-        (Method::Igimp, 3) => solve_mpm_3d(spec, Basis::Gimp, observer),
-        (Method::FemHex8, 3) => solve_fem_3d(spec, HexElement::Hex8, observer),
-        (Method::FemHex20, 3) => solve_fem_3d(spec, HexElement::Hex20, observer),
+        (Method::MaterialPoint(basis), 3) => solve_mpm_3d(spec, basis, observer),
+        (Method::FEM_HEX8, 3) => solve_fem_3d(spec, HexElement::Hex8, observer),
+        (Method::FEM_HEX20, 3) => solve_fem_3d(spec, HexElement::Hex20, observer),
         (_, 3) => Err(InputError::new(
             "dimension",
             3,
@@ -608,7 +620,7 @@ pub fn solve_column_observed(
                 method.name()
             ),
         )),
-        (Method::FemHex8 | Method::FemHex20, _) => Err(InputError::new(
+        (Method::FEM_HEX8 | Method::FEM_HEX20, _) => Err(InputError::new(
             "dimension",
             spec.dimension,
             format!("{} solves the 3D column (dimension = 3) only", method.name()),
@@ -623,15 +635,14 @@ fn match_1d(
     observer: &mut ColumnObserver<'_>,
 ) -> Result<ColumnOutcome, InputError> {
     match method {
-        Method::Mpm => solve_mpm_observed(spec, Basis::Mpm, observer),
-        Method::Igimp => solve_mpm_observed(spec, Basis::Gimp, observer),
-        Method::FemLinear => solve_fem_observed(spec, LineElement::Linear, observer),
-        Method::FemQuadratic => solve_fem_observed(spec, LineElement::Quadratic, observer),
+        Method::MaterialPoint(basis) => solve_mpm_observed(spec, basis, observer),
+        Method::FEM_LINEAR => solve_fem_observed(spec, LineElement::Linear, observer),
+        Method::FEM_QUADRATIC => solve_fem_observed(spec, LineElement::Quadratic, observer),
         _ => Err(method.unsupported("column", &METHODS)),
     }
 }
 
-/// Run the column with MPM or GIMP weights.
+/// Run the column with a material point method of basis `basis`.
 pub fn solve_mpm(spec: &ColumnSpec, basis: Basis) -> Result<ColumnOutcome, InputError> {
     solve_mpm_observed(spec, basis, &mut |_, _| {})
 }

@@ -389,10 +389,28 @@ fn run_fem_block<const D: usize, E: ElementFamily<D>>(
 }
 
 /// The methods that solve the plane-strain compaction.
-pub const METHODS: [Method; 4] = [Method::Igimp, Method::Mpm, Method::FemQ4, Method::FemQ8];
+pub const METHODS: [Method; 8] = [
+    Method::IGIMP,
+    Method::MPM,
+    Method::CPDI,
+    Method::BSPLINE2,
+    Method::BSPLINE3,
+    Method::TLMPM,
+    Method::FEM_Q4,
+    Method::FEM_Q8,
+];
 
 /// The methods that solve the 3D compaction.
-pub const METHODS_3D: [Method; 4] = [Method::Igimp, Method::Mpm, Method::FemHex8, Method::FemHex20];
+pub const METHODS_3D: [Method; 8] = [
+    Method::IGIMP,
+    Method::MPM,
+    Method::CPDI,
+    Method::BSPLINE2,
+    Method::BSPLINE3,
+    Method::TLMPM,
+    Method::FEM_HEX8,
+    Method::FEM_HEX20,
+];
 
 /// The methods of a compaction in `dimension` (2 or 3).
 pub fn methods(dimension: usize) -> &'static [Method] {
@@ -421,17 +439,16 @@ pub struct CompactionSolution {
     pub domains_3d: Vec<Domain3dRecord>,
 }
 
-/// Solve the compaction by `method`: iGIMP or MPM weights on the material points (the
-/// method sets `spec.basis`), or Q4/Q8 FEM ([`solve_fem`]).
+/// Solve the compaction by `method`: a material point family (the method sets
+/// `spec.basis`), or Q4/Q8 FEM ([`solve_fem`]).
 pub fn solve(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution, InputError> {
     if spec.dimension == 3 {
         return solve_3d(spec, method);
     }
     let basis = match method {
-        Method::Igimp => Basis::Gimp,
-        Method::Mpm => Basis::Mpm,
-        Method::FemQ4 | Method::FemQ8 => {
-            let element = if method == Method::FemQ4 {
+        Method::MaterialPoint(basis) => basis,
+        Method::FEM_Q4 | Method::FEM_Q8 => {
+            let element = if method == Method::FEM_Q4 {
                 QuadElement::Q4
             } else {
                 QuadElement::Q8
@@ -592,12 +609,7 @@ pub fn solve_fem_3d(spec: &CompactionSpec, element: HexElement) -> Result<FemOut
 /// The 3D compaction by `method` ([`solve_mpm_3d`], [`solve_fem_3d`]).
 fn solve_3d(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution, InputError> {
     let element = match method {
-        Method::Igimp | Method::Mpm => {
-            let basis = if method == Method::Igimp {
-                Basis::Gimp
-            } else {
-                Basis::Mpm
-            };
+        Method::MaterialPoint(basis) => {
             let o = solve_mpm_3d(&CompactionSpec { basis, ..*spec })?;
             return Ok(CompactionSolution {
                 size: o.num_points,
@@ -609,8 +621,8 @@ fn solve_3d(spec: &CompactionSpec, method: Method) -> Result<CompactionSolution,
                 domains_3d: o.points_3d,
             });
         }
-        Method::FemHex8 => HexElement::Hex8,
-        Method::FemHex20 => HexElement::Hex20,
+        Method::FEM_HEX8 => HexElement::Hex8,
+        Method::FEM_HEX20 => HexElement::Hex20,
         _ => return Err(unsupported(spec, method)),
     };
     let o = solve_fem_3d(spec, element)?;

@@ -55,7 +55,16 @@ impl Field {
 }
 
 /// The methods that solve the manufactured problem.
-pub const METHODS: [Method; 4] = [Method::Mpm, Method::Igimp, Method::FemQ4, Method::FemQ8];
+pub const METHODS: [Method; 8] = [
+    Method::MPM,
+    Method::IGIMP,
+    Method::CPDI,
+    Method::BSPLINE2,
+    Method::BSPLINE3,
+    Method::TLMPM,
+    Method::FEM_Q4,
+    Method::FEM_Q8,
+];
 
 /// One manufactured-solution analysis.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -474,8 +483,8 @@ pub fn solve(spec: &ManufacturedSpec, method: Method) -> Result<ManufacturedSolu
     }
     let exact = Exact::of(spec);
     let (steps, failure, points) = match method {
-        Method::Igimp | Method::Mpm => solve_mpm(spec, method)?,
-        Method::FemQ4 | Method::FemQ8 => solve_fem(spec, method)?,
+        Method::MaterialPoint(_) => solve_mpm(spec, method)?,
+        Method::FEM_Q4 | Method::FEM_Q8 => solve_fem(spec, method)?,
         _ => return Err(method.unsupported("manufactured problem", &METHODS)),
     };
     let errors = failure.is_none().then(|| errors(&exact, &points));
@@ -489,15 +498,11 @@ pub fn solve(spec: &ManufacturedSpec, method: Method) -> Result<ManufacturedSolu
 
 type Run = (Vec<StepReport>, Option<SolveError>, Vec<PointValue>);
 
-/// The material point settings of a manufactured case (2D or 3D): iGIMP or MPM weights, no
+/// The material point settings of a manufactured case (2D or 3D): the method's family, no
 /// treatment of nearly empty cells (the grid is the material: no cell is partly filled).
 pub(crate) fn mpm_settings(spec: &ManufacturedSpec, method: Method) -> MpmSettings {
     MpmSettings {
-        basis: if method == Method::Igimp {
-            Basis::Gimp
-        } else {
-            Basis::Mpm
-        },
+        basis: method.basis().unwrap_or(Basis::Gimp),
         domain_update: spec.domain_update,
         newton: spec.newton,
         load_steps: spec.load_steps,
@@ -509,16 +514,13 @@ pub(crate) fn mpm_settings(spec: &ManufacturedSpec, method: Method) -> MpmSettin
     }
 }
 
-/// The iGIMP (`igimp`) or MPM (`mpm`) solver of `spec`: points filling the unit square
+/// The material point solver of `spec` (any family): points filling the unit square
 /// grid, rollers on every edge, the dead load on the points, undeformed.
 pub fn mpm_solver(spec: &ManufacturedSpec, method: Method) -> Result<MpmSolver<2>, InputError> {
     spec.validate()?;
     let exact = &Exact::of(spec);
     if !method.uses_material_points() {
-        return Err(method.unsupported(
-            "manufactured material point solver",
-            &[Method::Igimp, Method::Mpm],
-        ));
+        return Err(method.unsupported("manufactured material point solver", &Method::MATERIAL_POINT));
     }
     let h = spec.element_size();
     let grid = Grid::try_new([0.0, 0.0], [h, h], [spec.cells, spec.cells])?;
@@ -565,10 +567,10 @@ fn solve_mpm(spec: &ManufacturedSpec, method: Method) -> Result<Run, InputError>
 pub fn fem_solver(spec: &ManufacturedSpec, method: Method) -> Result<PlaneFem, InputError> {
     spec.validate()?;
     let exact = &Exact::of(spec);
-    if !matches!(method, Method::FemQ4 | Method::FemQ8) {
-        return Err(method.unsupported("manufactured FEM solver", &[Method::FemQ4, Method::FemQ8]));
+    if !matches!(method, Method::FEM_Q4 | Method::FEM_Q8) {
+        return Err(method.unsupported("manufactured FEM solver", &[Method::FEM_Q4, Method::FEM_Q8]));
     }
-    let element = if method == Method::FemQ4 {
+    let element = if method == Method::FEM_Q4 {
         QuadElement::Q4
     } else {
         QuadElement::Q8

@@ -33,7 +33,16 @@ use std::f64::consts::PI;
 type V3 = SVector<f64, 3>;
 
 /// The methods that solve the 3D manufactured problem.
-pub const METHODS_3D: [Method; 4] = [Method::Mpm, Method::Igimp, Method::FemHex8, Method::FemHex20];
+pub const METHODS_3D: [Method; 8] = [
+    Method::MPM,
+    Method::IGIMP,
+    Method::CPDI,
+    Method::BSPLINE2,
+    Method::BSPLINE3,
+    Method::TLMPM,
+    Method::FEM_HEX8,
+    Method::FEM_HEX20,
+];
 
 /// F = diag(F₂(X, Y), f₃₃(Z)) of the 3D fields.
 fn block_gradient<T: DualNum<Primitive = f64> + Copy>(field: Field, a: f64, x: [T; 3]) -> (M2<T>, T) {
@@ -204,7 +213,7 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
     let model = || LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio).map(Box::new);
     let h = spec.element_size();
     let (steps, failure, values) = match method {
-        Method::Igimp | Method::Mpm => {
+        Method::MaterialPoint(_) => {
             let grid = Grid::try_new([0.0; 3], [h; 3], [spec.cells; 3])?;
             let ppc = spec.points_per_cell;
             let points = MaterialPoints::fill_box(&grid, [0.0; 3], [1.0; 3], [ppc; 3], 1.0)?;
@@ -241,8 +250,8 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
                 .collect();
             (steps, failure, values)
         }
-        Method::FemHex8 | Method::FemHex20 => {
-            let element = if method == Method::FemHex8 {
+        Method::FEM_HEX8 | Method::FEM_HEX20 => {
+            let element = if method == Method::FEM_HEX8 {
                 HexElement::Hex8
             } else {
                 HexElement::Hex20

@@ -391,7 +391,7 @@ fn render_figure(
             };
             // The full description is in the report; the title only names the reference.
             let short = match (reference.method, reference.observed_order) {
-                (Method::Igimp, _) => "finest iGIMP (no FEM)".to_string(),
+                (Method::IGIMP, _) => "finest iGIMP (no FEM)".to_string(),
                 (m, Some(_)) => format!("{}, extrapolated", m.label()),
                 (m, None) => format!("finest {}", m.label()),
             };

@@ -73,12 +73,12 @@ fn column_dimension_is_validated() {
             dimension: 3,
             ..ColumnSpec::default()
         },
-        Method::FemLinear,
+        Method::FEM_LINEAR,
     )
     .unwrap_err();
     assert_eq!(e.field, "dimension");
-    assert!(e.allowed.contains("mpm, igimp, fem-hex8, fem-hex20"), "{e}");
+    assert!(e.allowed.contains("mpm, igimp, cpdi, bspline2, bspline3, tlmpm, fem-hex8, fem-hex20"), "{e}");
     // The 3D elements are not 1D methods.
-    let e = solve_column(&ColumnSpec::default(), Method::FemHex8).unwrap_err();
+    let e = solve_column(&ColumnSpec::default(), Method::FEM_HEX8).unwrap_err();
     assert_eq!(e.field, "dimension");
 }

@@ -92,7 +92,7 @@ fn f_diagonal_equals_stretch_only_without_rotation() {
     let (a, b) = (find("vortex", "stretch"), find("vortex", "fdiag"));
     assert!((a.displacement_error.unwrap() / b.displacement_error.unwrap() - 1.0).abs() > 1e-2);
     assert_eq!(a.domain_update, Some(DomainUpdate::Stretch));
-    assert_eq!(a.method, Method::Igimp);
+    assert_eq!(a.method, Method::IGIMP);
 }
 
 /// The report and figures are written, and `study --render-only` recreates them byte for byte.

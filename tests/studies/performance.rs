@@ -54,11 +54,11 @@ fn performance_fields_match_the_problem_size_and_add_up() {
         assert!(!c.steps.is_empty(), "{}", c.id);
         for s in &c.steps {
             match c.method {
-                Method::FemQ4 => {
+                Method::FEM_Q4 => {
                     let (n, nnz) = q4_compaction_size(w, ht, c.h);
                     assert_eq!((s.unknowns, s.nonzeros), (n, nnz), "{} step {}", c.id, s.step);
                 }
-                Method::FemQ8 => {
+                Method::FEM_Q8 => {
                     // Corner and mid-side nodes (no centre node); a corner node couples with
                     // the 21 nodes of its four elements.
                     let (nx, ny) = ((w / c.h).round() as usize, (ht / c.h).round() as usize);
@@ -91,7 +91,7 @@ fn performance_fields_match_the_problem_size_and_add_up() {
             // Direct solves by LU here: no LDLᵀ factor to count, no CG iterations.
             assert_eq!(s.linear_iterations, 0, "{}", c.id);
         }
-        q4 += usize::from(c.method == Method::FemQ4);
+        q4 += usize::from(c.method == Method::FEM_Q4);
     }
     assert!(q4 >= 3, "the quick tier has Q4 cases ({q4})");
 

@@ -44,7 +44,7 @@ fn quick() -> &'static StudyRun {
 }
 
 fn is_fem(m: Method) -> bool {
-    matches!(m, Method::FemLinear | Method::FemQuadratic)
+    matches!(m, Method::FEM_LINEAR | Method::FEM_QUADRATIC)
 }
 
 fn expected_rate(method: Method, measure: Measure) -> &'static RateRecord {
@@ -89,10 +89,10 @@ fn igimp_quick_tier_rates_inside_study_bands() {
     assert!(
         checked
             .iter()
-            .any(|r| r.method == Method::Igimp && r.measure == Measure::StressError)
+            .any(|r| r.method == Method::IGIMP && r.measure == Measure::StressError)
             && checked
                 .iter()
-                .any(|r| r.method == Method::Igimp && r.measure == Measure::FError),
+                .any(|r| r.method == Method::IGIMP && r.measure == Measure::FError),
         "the quick tier must check iGIMP stress and F error rates"
     );
     for r in checked {
@@ -108,7 +108,7 @@ fn igimp_quick_tier_rates_inside_study_bands() {
         assert_eq!(c.pass, Some(true), "comparison failed: {c:?}");
     }
     // The iGIMP cases of the quick tier all converge.
-    for c in run.results.cases.iter().filter(|c| c.method == Method::Igimp) {
+    for c in run.results.cases.iter().filter(|c| c.method == Method::IGIMP) {
         assert_eq!(c.status, CaseStatus::Converged, "{}: {:?}", c.id, c.failure);
     }
 }
@@ -116,7 +116,7 @@ fn igimp_quick_tier_rates_inside_study_bands() {
 /// Paper §5.1, Figure 11: linear FEM's stress error converges at rate 1 ± 0.1.
 #[test]
 fn fem_linear_stress_error_rate_is_1() {
-    let r = expected_rate(Method::FemLinear, Measure::StressError);
+    let r = expected_rate(Method::FEM_LINEAR, Measure::StressError);
     assert_eq!(
         r.expected.as_ref().map(|b| (b.rate, b.tolerance)),
         Some((1.0, 0.1))
@@ -127,13 +127,13 @@ fn fem_linear_stress_error_rate_is_1() {
 /// Paper Table 1: linear FEM's base F error converges at rate 1 ± 0.1.
 #[test]
 fn fem_linear_f_error_rate_is_1() {
-    assert_in_band(expected_rate(Method::FemLinear, Measure::FError));
+    assert_in_band(expected_rate(Method::FEM_LINEAR, Measure::FError));
 }
 
 /// Paper §5.1, Figure 11: quadratic FEM's stress error converges at rate 2 ± 0.2.
 #[test]
 fn fem_quadratic_stress_error_rate_is_2() {
-    let r = expected_rate(Method::FemQuadratic, Measure::StressError);
+    let r = expected_rate(Method::FEM_QUADRATIC, Measure::StressError);
     assert_eq!(
         r.expected.as_ref().map(|b| (b.rate, b.tolerance)),
         Some((2.0, 0.2))
@@ -149,7 +149,7 @@ fn igimp_stress_error_below_linear_fem_at_equal_elements() {
         .measures
         .comparisons
         .iter()
-        .find(|c| c.lower == Method::Igimp && c.higher == Method::FemLinear)
+        .find(|c| c.lower == Method::IGIMP && c.higher == Method::FEM_LINEAR)
         .expect("comparison igimp < fem-linear in the study file");
     assert!(c.elements_checked.len() >= 3, "{c:?}");
     assert_eq!(c.pass, Some(true), "{c:?}");
@@ -449,7 +449,7 @@ fn plastic_column_quick_tier_meets_its_bands_and_yield_height() {
         .results
         .cases
         .iter()
-        .filter(|c| c.method == Method::Igimp && c.load == 400000.0)
+        .filter(|c| c.method == Method::IGIMP && c.load == 400000.0)
         .max_by_key(|c| c.elements)
         .unwrap();
     let csv =

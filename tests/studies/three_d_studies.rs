@@ -74,7 +74,7 @@ fn compaction_3d_quick_tier_converges_quadratically_and_passes_its_checks() {
     // The quick tier has the reference's three Hex8 meshes: the full tier's extrapolation,
     // 0.454910 (reports/compaction-3d, 2026-12-01), to round-off.
     let reference = r.measures.reference.as_ref().expect("a reference");
-    assert_eq!(reference.method, Method::FemHex8);
+    assert_eq!(reference.method, Method::FEM_HEX8);
     assert!(
         (reference.value / 0.454910 - 1.0).abs() < 1e-6,
         "{}",

@@ -253,9 +253,9 @@ fn column_3d_writes_points_and_hexahedral_grids_read_by_meshio() {
         ..ColumnSpec::default()
     };
     for (method, cell, nodes) in [
-        (Method::Igimp, "hexahedron", 8),
-        (Method::FemHex8, "hexahedron", 8),
-        (Method::FemHex20, "hexahedron20", 20),
+        (Method::IGIMP, "hexahedron", 8),
+        (Method::FEM_HEX8, "hexahedron", 8),
+        (Method::FEM_HEX20, "hexahedron20", 20),
     ] {
         let id = method.name();
         let mut w = ColumnVtkWriter::new(tmp.path(), id, spec.load_steps, VtkOptions { every: 1 }).unwrap();
@@ -284,7 +284,7 @@ fn column_3d_writes_points_and_hexahedral_grids_read_by_meshio() {
         assert_eq!(n_points, outcome.points.len(), "{id}");
         let (z0, uz) = (column(pts, "position0", 2), column(pts, "displacement", 2));
         let grid_uz = column(grid, "displacement", 2);
-        let top = if method == Method::Igimp {
+        let top = if method == Method::IGIMP {
             let p = (0..n_points).max_by(|&a, &b| z0[a].total_cmp(&z0[b])).unwrap();
             uz[p]
         } else {
@@ -486,7 +486,7 @@ fn plane_studies_resume_and_write_vtk() {
     for c in a
         .cases
         .iter()
-        .filter(|c| c.method == igimp::method::Method::Igimp)
+        .filter(|c| c.method == igimp::method::Method::IGIMP)
     {
         assert!(
             tmp.path()

@@ -89,7 +89,7 @@ fn paper_table1_igimp_rows() {
     let printed_f = [0.74322, 0.74307, 0.74300, 0.74296];
     let printed_err = [4.091e-4, 2.041e-4, 1.017e-4, 5.040e-5];
     for (k, &n) in [256usize, 512, 1024, 2048].iter().enumerate() {
-        let o = solve_column(&table1_spec(n), Method::Igimp).unwrap();
+        let o = solve_column(&table1_spec(n), Method::IGIMP).unwrap();
         assert!(o.failure.is_none(), "{n}: {:?}", o.failure);
         assert!(
             (o.top_displacement + 7.3347).abs() <= 1.5e-4,
@@ -123,8 +123,8 @@ fn paper_table1_igimp_rows() {
 fn paper_figure8_mpm_stress_error_is_many_times_gimp() {
     let spec = ColumnSpec::default();
     assert_eq!((spec.elements, spec.weight), (50, 40_000.0));
-    let gimp = solve_column(&spec, Method::Igimp).unwrap();
-    let mpm = solve_column(&spec, Method::Mpm).unwrap();
+    let gimp = solve_column(&spec, Method::IGIMP).unwrap();
+    let mpm = solve_column(&spec, Method::MPM).unwrap();
     assert!(gimp.failure.is_none() && mpm.failure.is_none());
     let ratio = mpm.stress_error / gimp.stress_error;
     assert!(
@@ -254,7 +254,7 @@ fn bad_column_input_names_the_field() {
         ),
     ];
     for (spec, field) in cases {
-        for method in [Method::Igimp, Method::Mpm] {
+        for method in [Method::IGIMP, Method::MPM] {
             let err = solve_column(&spec, method).expect_err(field);
             assert!(err.field.contains(field), "expected field {field}, got {err}");
             assert!(!err.allowed.is_empty());
@@ -282,7 +282,7 @@ fn points_outside_grid_rejected_and_divergence_recorded() {
         },
         ..table1_spec(16)
     };
-    let o = solve_column(&spec, Method::Igimp).unwrap();
+    let o = solve_column(&spec, Method::IGIMP).unwrap();
     let f = o.failure.expect("must fail");
     assert_eq!(f.step, 1);
     assert_eq!(f.residuals.len(), 2);

@@ -232,7 +232,7 @@ fn bad_compaction_input_names_the_field() {
     }
 }
 
-/// Plain MPM weights on the same points (Method::Mpm; the problem sets the basis) converge
+/// Plain MPM weights on the same points (Method::MPM; the problem sets the basis) converge
 /// and agree with iGIMP: at h = 1, 2×2 points, max horizontal u 0.586795 against 0.592824
 /// (1.0 %, measured 2026-12-01; 0.86 % at h = 0.5). Band 2 %: the two weightings differ by
 /// the GIMP smoothing only, which is O(h) here. A method the problem has no solution for is
@@ -242,13 +242,13 @@ fn mpm_weights_solve_the_compaction_and_other_methods_are_named_errors() {
     use igimp::method::Method;
     use igimp::problems::compaction::solve;
     let spec = CompactionSpec::default();
-    let mpm = solve(&spec, Method::Mpm).unwrap();
-    let gimp = solve(&spec, Method::Igimp).unwrap();
+    let mpm = solve(&spec, Method::MPM).unwrap();
+    let gimp = solve(&spec, Method::IGIMP).unwrap();
     assert!(mpm.failure.is_none() && gimp.failure.is_none());
     let dev = (mpm.max_horizontal_displacement / gimp.max_horizontal_displacement - 1.0).abs();
     assert!(dev < 0.02, "MPM vs iGIMP: {dev:.4}");
     assert!(dev > 1e-4, "MPM must not be the iGIMP run: {dev:.2e}");
-    let e = solve(&spec, Method::FemLinear).unwrap_err();
+    let e = solve(&spec, Method::FEM_LINEAR).unwrap_err();
     assert_eq!(e.field, "method");
     assert!(e.allowed.contains("igimp, mpm, fem-q4, fem-q8"), "{e}");
 }
@@ -289,7 +289,7 @@ fn compaction_3d_fem_converges_quadratically() {
         ..CompactionSpec::default()
     };
     let mut us = vec![];
-    for method in [Method::FemHex8, Method::FemHex20] {
+    for method in [Method::FEM_HEX8, Method::FEM_HEX20] {
         let o = solve(&spec, method).unwrap();
         assert!(o.failure.is_none(), "{method:?}: {:?}", o.failure);
         assert_eq!(o.size, 4 * 4 * 8);
@@ -306,7 +306,7 @@ fn compaction_3d_fem_converges_quadratically() {
     );
     assert!(hex20.abs() < 5e-3, "Hex20 {hex20:e} from iGIMP");
     assert!(hex8 < hex20 && hex8.abs() < 4e-2, "Hex8 {hex8:e} from iGIMP");
-    let e = solve(&spec, Method::FemQ4).unwrap_err();
+    let e = solve(&spec, Method::FEM_Q4).unwrap_err();
     assert_eq!(e.field, "method");
     assert!(e.allowed.contains("igimp, mpm, fem-hex8, fem-hex20"), "{e}");
 }

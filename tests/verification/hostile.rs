@@ -485,7 +485,7 @@ proptest! {
         let ok = no_panic("ColumnSpec::validate", || spec.validate())?.is_some();
         let small = elements * points_per_cell <= 64 && load_steps <= 3 && newton.max_iterations <= 40;
         if ok && small {
-            for m in [Method::Mpm, Method::Igimp, Method::FemLinear, Method::FemQuadratic] {
+            for m in [Method::MPM, Method::IGIMP, Method::FEM_LINEAR, Method::FEM_QUADRATIC] {
                 no_panic(&format!("solve_column {m:?} {spec:?}"), || solve_column(&spec, m))?;
             }
         }

@@ -9,6 +9,7 @@ mod basis;
 mod column;
 mod compaction;
 mod elastica;
+mod families;
 mod fem;
 mod fem2d;
 mod fem3d;

@@ -180,14 +180,14 @@ fn exact_field_residual_converges() {
     };
     let mut report = vec![];
     for (field, method, expected) in [
-        (Field::AxisAligned, Method::FemQ4, 1.95),
-        (Field::AxisAligned, Method::FemQ8, 1.97),
-        (Field::Vortex, Method::FemQ4, 1.58),
-        (Field::Vortex, Method::FemQ8, 1.63),
-        (Field::AxisAligned, Method::Igimp, 1.97),
-        (Field::Vortex, Method::Igimp, 1.63),
-        (Field::AxisAligned, Method::Mpm, 1.97),
-        (Field::Vortex, Method::Mpm, 1.63),
+        (Field::AxisAligned, Method::FEM_Q4, 1.95),
+        (Field::AxisAligned, Method::FEM_Q8, 1.97),
+        (Field::Vortex, Method::FEM_Q4, 1.58),
+        (Field::Vortex, Method::FEM_Q8, 1.63),
+        (Field::AxisAligned, Method::IGIMP, 1.97),
+        (Field::Vortex, Method::IGIMP, 1.63),
+        (Field::AxisAligned, Method::MPM, 1.97),
+        (Field::Vortex, Method::MPM, 1.63),
     ] {
         let r: Vec<f64> = [8, 16, 32].iter().map(|&n| residual(field, method, n)).collect();
         let h = [1.0 / 8.0, 1.0 / 16.0, 1.0 / 32.0];
@@ -276,8 +276,8 @@ fn manufactured_3d_vortex_equals_the_plane_strain_run() {
     };
     let cube = ManufacturedSpec { dimension: 3, ..spec };
     let (e3, e2) = (
-        solve_3d(&cube, Method::Igimp).unwrap().errors.unwrap(),
-        solve(&spec, Method::Igimp).unwrap().errors.unwrap(),
+        solve_3d(&cube, Method::IGIMP).unwrap().errors.unwrap(),
+        solve(&spec, Method::IGIMP).unwrap().errors.unwrap(),
     );
     for (a, b) in [(e3.displacement, e2.displacement), (e3.stress, e2.stress)] {
         assert!((a / b - 1.0).abs() < 1e-12, "3D {a:e} against 2D {b:e}");

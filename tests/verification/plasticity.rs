@@ -136,7 +136,7 @@ fn bad_yield_stress_is_an_error() {
             yield_stress: Some(ry),
             ..ColumnSpec::default()
         };
-        assert!(solve_column(&spec, Method::Igimp)
+        assert!(solve_column(&spec, Method::IGIMP)
             .unwrap_err()
             .field
             .contains("yield_stress"));
@@ -226,7 +226,7 @@ fn gimp_plastic_column_converges_to_analytical_solution() {
     let mut last_zy = 0.0;
     for n in levels {
         let spec = plastic_spec(400_000.0, n);
-        let o = solve_column(&spec, Method::Igimp).unwrap();
+        let o = solve_column(&spec, Method::IGIMP).unwrap();
         assert!(o.failure.is_none());
         let a = spec.analytical();
         let sxx_err: f64 = o

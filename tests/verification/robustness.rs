@@ -42,7 +42,7 @@ fn one_point_per_cell_column_converges_with_ghost_on_every_face() {
     let mut stress = vec![];
     let mut f_err = vec![];
     for &n in &elements {
-        let o = solve_column(&one_point_column(n, ghost), Method::Igimp).unwrap();
+        let o = solve_column(&one_point_column(n, ghost), Method::IGIMP).unwrap();
         assert!(o.failure.is_none(), "{n} elements: {:?}", o.failure);
         stress.push(o.stress_error);
         f_err.push(o.f_error);
@@ -53,7 +53,7 @@ fn one_point_per_cell_column_converges_with_ghost_on_every_face() {
     assert!((0.8..=2.2).contains(&rs), "stress rate {rs}");
     // Table 1's F errors halve with the element count (rate 1): the same here.
     assert!((0.9..=1.1).contains(&rf), "F rate {rf}");
-    let untreated = solve_column(&one_point_column(128, GhostSettings::default()), Method::Igimp).unwrap();
+    let untreated = solve_column(&one_point_column(128, GhostSettings::default()), Method::IGIMP).unwrap();
     assert!(
         untreated.failure.is_some(),
         "untreated one point per cell completed at 128 elements"
@@ -74,7 +74,7 @@ fn one_point_column_gamma_sensitivity_is_small() {
                 faces: GhostFaces::All,
                 ..Default::default()
             };
-            solve_column(&one_point_column(256, g), Method::Igimp)
+            solve_column(&one_point_column(256, g), Method::IGIMP)
                 .unwrap()
                 .top_displacement
         })

@@ -161,11 +161,11 @@ fn tangent_error_with<const D: usize>(
     max_err / max_k
 }
 
-/// 1D GIMP column after 8 load steps at W = 400,000 (F ≈ 0.85 at the base), ν = 0.3 so the
+/// 1D column of every basis family after 8 load steps at W = 400,000 (F ≈ 0.85 at the base), ν = 0.3 so the
 /// out-of-plane stresses enter, evaluated at a random trial increment.
 #[test]
 fn gimp_1d_global_tangent_matches_central_differences() {
-    for basis in [Basis::Gimp, Basis::Mpm] {
+    for basis in Basis::ALL {
         let spec = ColumnSpec {
             elements: 12,
             weight: 400_000.0,
@@ -203,6 +203,12 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
     let variants = [
         (Basis::Gimp, off, [4.0, 3.0]),
         (Basis::Mpm, off, [4.0, 3.0]),
+        (Basis::Cpdi, off, [4.0, 3.0]),
+        (Basis::Bspline2, off, [4.0, 3.0]),
+        (Basis::Bspline3, off, [4.0, 3.0]),
+        (Basis::Tlmpm, off, [4.0, 3.0]),
+        (Basis::Bspline2, cut, [3.5, 2.5]),
+        (Basis::Cpdi, cut, [3.5, 2.5]),
         (Basis::Gimp, all, [4.0, 3.0]),
         (Basis::Gimp, cut, [3.5, 2.5]),
         (Basis::Mpm, cut, [3.5, 2.5]),
@@ -331,7 +337,8 @@ fn spatial_tangent_eigen_form_equals_literal_eq25() {
 fn gimp_3d_global_tangent_matches_central_differences_rotated_stretched_plastic_state() {
     use igimp::constitutive::VonMises;
     use nalgebra::{Rotation3, Unit, Vector3};
-    for (basis, plastic) in [(Basis::Gimp, false), (Basis::Mpm, false), (Basis::Gimp, true)] {
+    let every = Basis::ALL.into_iter().flat_map(|b| [(b, false), (b, true)]);
+    for (basis, plastic) in every {
         let grid = Grid::try_new([0.0; 3], [1.0; 3], [4, 4, 4]).unwrap();
         let mut points = MaterialPoints::fill_box(&grid, [1.0; 3], [3.0; 3], [2, 2, 2], 10.0).unwrap();
         let model: Box<dyn ConstitutiveModel> = if plastic {

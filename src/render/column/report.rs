@@ -133,7 +133,7 @@ pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::render::NotD
             let finest = results
                 .cases
                 .iter()
-                .filter(|c| c.load == load && c.method == Method::Igimp && c.yield_height.is_some())
+                .filter(|c| c.load == load && c.method == Method::IGIMP && c.yield_height.is_some())
                 .max_by_key(|c| c.elements);
             let _ = writeln!(
                 s,

@@ -5,7 +5,6 @@
 
 use super::records::{CantileverMeasures, CantileverRecord, ElasticaPath, ElasticaPoint};
 use super::{CantileverCase, CantileverStudy};
-use crate::method::Method;
 use crate::problems::cantilever::{solve, CantileverSpec, DomainSnapshot, SolidSnapshot};
 use crate::problems::elastica::{bending_stiffness, Elastica};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
@@ -46,7 +45,7 @@ fn solve_case_snapshots(
     snapshot_every: usize,
 ) -> (CantileverRecord, Vec<DomainSnapshot>, Vec<SolidSnapshot>) {
     let s = &case.spec;
-    let igimp = case.method == Method::Igimp;
+    let method = case.method;
     let (solved, o) = match solve(s, case.method, snapshot_every) {
         Err(e) => (SolveRecord::rejected(e), None),
         Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
@@ -68,8 +67,8 @@ fn solve_case_snapshots(
     let rec = CantileverRecord {
         id: case.id.clone(),
         method: case.method,
-        domain_update: igimp.then_some(s.domain_update),
-        volume_update: igimp.then_some(s.volume_update),
+        domain_update: method.uses_domain_update().then_some(s.domain_update),
+        volume_update: method.uses_material_points().then_some(s.volume_update),
         depth: s.depth,
         load: s.load,
         element_size: s.element_size,

@@ -51,14 +51,14 @@ pub(super) fn figure17_reference(results: &CompactionResults) -> Option<Referenc
     let finest = results
         .sweep(&results.study.reference.igimp_sweep)
         .into_iter()
-        .filter(|c| c.method == Method::Igimp && c.max_horizontal_displacement.is_some())
+        .filter(|c| c.method == Method::IGIMP && c.max_horizontal_displacement.is_some())
         .min_by(|a, b| {
             a.h.total_cmp(&b.h)
                 .then(b.points_per_cell.cmp(&a.points_per_cell))
         })?;
     Some(ReferenceRecord {
         value: finest.max_horizontal_displacement?,
-        method: Method::Igimp,
+        method: Method::IGIMP,
         cases: vec![finest.id.clone()],
         observed_order: None,
         description: format!(
@@ -79,7 +79,7 @@ pub(super) fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
         results
             .sweep(sweep)
             .into_iter()
-            .filter(|c| c.method == Method::Igimp && c.max_horizontal_displacement.is_some())
+            .filter(|c| c.method == Method::IGIMP && c.max_horizontal_displacement.is_some())
             .collect()
     };
     let deviation = |c: &CompactionRecord| -> Option<f64> {

@@ -107,7 +107,7 @@ impl CompactionStudy {
                     self.weak_nodes.tolerance,
                     None,
                 );
-                Some(self.case_id(Method::Igimp, &spec))
+                Some(self.case_id(Method::IGIMP, &spec))
             })
             .collect()
     }

@@ -70,7 +70,7 @@ impl CompactionResults {
     /// The iGIMP case of a sweep at (h, points per cell) with the study's weak-node tolerance.
     pub fn igimp_case(&self, sweep: &str, h: f64, ppc: usize) -> Option<&CompactionRecord> {
         self.sweep(sweep).into_iter().find(|c| {
-            c.method == Method::Igimp && c.h == h && c.points_per_cell == Some(ppc) && self.is_default(c)
+            c.method == Method::IGIMP && c.h == h && c.points_per_cell == Some(ppc) && self.is_default(c)
         })
     }
 

@@ -3,7 +3,6 @@
 use super::plan::update_tag;
 use super::records::{ExpectedBand, ManufacturedResults, RateRecord, Series};
 use super::ErrorMeasure;
-use crate::method::Method;
 use crate::mpm::DomainUpdate;
 use crate::study::checks::{check_rate, fitted_rate_finest, CheckRecord};
 
@@ -30,7 +29,7 @@ pub(super) fn rates(results: &ManufacturedResults) -> Vec<RateRecord> {
                             && x.method == s.method
                             && x.measure == measure
                             && x.points_per_cell.map(|p| p as usize) == s.points_per_cell
-                            && (s.method != Method::Igimp
+                            && (!s.method.uses_domain_update()
                                 || Some(x.domain_update.unwrap_or(DomainUpdate::Stretch)) == s.domain_update)
                     })
                     .map(|x| ExpectedBand {
@@ -65,7 +64,10 @@ pub(super) fn checks(results: &ManufacturedResults) -> Vec<CheckRecord> {
         .map(|x| {
             let s = Series {
                 method: x.method,
-                domain_update: (x.method == Method::Igimp).then(|| x.domain_update.unwrap_or_default()),
+                domain_update: x
+                    .method
+                    .uses_domain_update()
+                    .then(|| x.domain_update.unwrap_or_default()),
                 points_per_cell: x.points_per_cell.map(|p| p as usize),
             };
             let r = rates

@@ -29,7 +29,10 @@ fn solve_case(case: &ManufacturedCase) -> (ManufacturedRecord, CasePoints) {
         id: case.id.clone(),
         field: case.spec.field,
         method: case.method,
-        domain_update: (case.method == Method::Igimp).then_some(case.spec.domain_update),
+        domain_update: case
+            .method
+            .uses_domain_update()
+            .then_some(case.spec.domain_update),
         cells: case.spec.cells,
         points_per_cell: mp.then_some(case.spec.points_per_cell),
         status: solved.status,
@@ -149,9 +152,9 @@ impl StudyKind for ManufacturedStudy {
         let d = c.spec.dimension as i32;
         let n = c.spec.cells as f64;
         let per_cell = match c.method {
-            Method::Igimp | Method::Mpm => (c.spec.points_per_cell as f64).powi(d),
+            Method::MaterialPoint(_) => (c.spec.points_per_cell as f64).powi(d),
             // Gauss points, and a Hex20 point couples 60 × 60 unknowns (8 × Hex8's 24 × 24).
-            Method::FemHex20 => 27.0 * 6.0,
+            Method::FEM_HEX20 => 27.0 * 6.0,
             _ => 3f64.powi(d),
         };
         n.powi(d) * per_cell
@@ -240,7 +243,7 @@ impl ManufacturedStudy {
                     f.points_per_cell?,
                     f.domain_update.unwrap_or_default(),
                 );
-                Some(Self::case_id(Method::Igimp, &spec))
+                Some(Self::case_id(Method::IGIMP, &spec))
             })
             .collect()
     }

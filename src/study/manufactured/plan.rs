@@ -145,11 +145,11 @@ impl ManufacturedStudy {
                 _ => {}
             }
             if let Some(u) = e.domain_update {
-                if e.method != Method::Igimp || !s.domain_updates.contains(&u) {
+                if !e.method.uses_domain_update() || !s.domain_updates.contains(&u) {
                     return Err(chk.err(
                         k("domain_update"),
                         update_tag(u),
-                        "must be an igimp domain update of the sweep",
+                        "must be a domain update of the sweep, on a method that has domain updates (igimp)",
                     ));
                 }
             }
@@ -248,7 +248,7 @@ impl ManufacturedStudy {
     /// `<field>-<method>[-<update>]-n<cells>[-p<ppc>]`.
     pub fn case_id(method: Method, spec: &ManufacturedSpec) -> String {
         let mut id = format!("{}-{}", spec.field.name(), method.name());
-        if method == Method::Igimp {
+        if method.uses_domain_update() {
             id.push_str(&format!("-{}", update_tag(spec.domain_update)));
         }
         id.push_str(&format!("-n{}", spec.cells));
@@ -261,7 +261,7 @@ impl ManufacturedStudy {
     pub(super) fn sweep_cases(&self, s: &ManufacturedSweep, plan: &SweepPlan) -> Vec<ManufacturedCase> {
         let mut out = vec![];
         for &method in &plan.methods {
-            let updates = if method == Method::Igimp {
+            let updates = if method.uses_domain_update() {
                 s.domain_updates.clone()
             } else {
                 vec![DomainUpdate::Stretch]

@@ -1,0 +1,548 @@
+//! Weighting functions S_vp and their gradients behind one contract, [`BasisFamily`]: each
+//! family (plain MPM, GIMP split per element (eqs 7–10), CPDI2, quadratic and cubic
+//! B-splines, total-Lagrangian MPM) is one file that owns its support, its weights and
+//! gradients at a point from the point's state ([`PointView`]: position, domain, F, corners),
+//! its domain state update, its reference configuration and the region the ghost penalty
+//! counts as its material. Solvers, problems and studies name a family by [`Basis`] and never
+//! match on it.
+//!
+//! The tensor-product families are written one axis at a time ([`AxisKernel`]) and combined
+//! by [`TensorProduct`], as the paper does for 2D (§2.2). Evaluation fills caller-owned values
+//! and never allocates.
+
+pub mod bspline;
+pub mod cpdi;
+pub mod gimp;
+pub mod linear;
+pub mod total_lagrangian;
+
+pub use bspline::{BsplineKernel, SplineBoundary, SplineDegree};
+pub use cpdi::Cpdi;
+pub use gimp::{gimp_element_weights, GimpKernel};
+pub use linear::LinearKernel;
+pub use total_lagrangian::TotalLagrangian;
+
+use crate::grid::Grid;
+use crate::kinematics::stretch_tensor;
+use nalgebra::{Matrix3, SVector};
+use serde::{Deserialize, Serialize};
+
+/// Most nodes a point may touch along one axis: a GIMP domain up to two elements long (a
+/// cubic B-spline touches 4).
+pub const MAX_AXIS_NODES: usize = 5;
+
+/// Most nodes one integration point may touch: [`MAX_AXIS_NODES`] per axis in 3D.
+pub const MAX_POINT_NODES: usize = MAX_AXIS_NODES * MAX_AXIS_NODES * MAX_AXIS_NODES;
+
+/// Weights along one axis: nodes `first .. first + len` with values `w` and derivatives `dw`
+/// with respect to the grid coordinate.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct AxisWeights {
+    pub first: usize,
+    pub len: usize,
+    pub w: [f64; MAX_AXIS_NODES],
+    pub dw: [f64; MAX_AXIS_NODES],
+}
+
+/// Why weights could not be evaluated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BasisError {
+    /// The point (or its domain) is not inside the grid along this axis.
+    OutsideGrid { axis: usize },
+    /// The domain spans more than `MAX_AXIS_NODES - 1` elements.
+    DomainTooLarge { axis: usize },
+    /// The domain half-length is not positive and finite (a collapsed GIMP domain).
+    DegenerateDomain { axis: usize },
+    /// A corner-tracked domain (CPDI) folded over (its map's Jacobian is not positive), or a
+    /// total-Lagrangian point's F is singular.
+    InvertedDomain,
+    /// The family is not a tensor product of axis kernels (CPDI, TLMPM) and was asked for
+    /// one axis's weights.
+    NotTensorProduct,
+}
+
+impl std::fmt::Display for BasisError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BasisError::OutsideGrid { axis } => write!(f, "outside the background grid along axis {axis}"),
+            BasisError::DomainTooLarge { axis } => {
+                write!(
+                    f,
+                    "domain longer than {} elements along axis {axis}",
+                    MAX_AXIS_NODES - 2
+                )
+            }
+            BasisError::DegenerateDomain { axis } => {
+                write!(f, "domain length collapsed to <= 0 along axis {axis}")
+            }
+            BasisError::InvertedDomain => write!(f, "domain inverted (Jacobian of its map <= 0)"),
+            BasisError::NotTensorProduct => write!(f, "not a tensor-product basis"),
+        }
+    }
+}
+
+/// One axis of a background grid.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridAxis {
+    /// Which axis (for error messages).
+    pub axis: usize,
+    pub origin: f64,
+    /// Element size h.
+    pub spacing: f64,
+    pub cells: usize,
+}
+
+impl GridAxis {
+    /// Axis `a` of `grid`.
+    pub fn of<const D: usize>(grid: &Grid<D>, a: usize) -> Self {
+        GridAxis {
+            axis: a,
+            origin: grid.origin()[a],
+            spacing: grid.spacing()[a],
+            cells: grid.cells()[a],
+        }
+    }
+}
+
+/// How material point domains are updated at the end of a load step (§3.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum DomainUpdate {
+    /// l_i = l_i0 U_ii with the right stretch tensor U = √(FᵀF), eq (39) (the paper's choice).
+    #[default]
+    Stretch,
+    /// l_i = l_i0 F_ii, eq (37) (cpGIMP); fails under large rotation.
+    FDiagonal,
+    /// Domains never change (uGIMP).
+    Fixed,
+}
+
+impl DomainUpdate {
+    /// Domain half-lengths of a point with initial half-lengths `r0` after committing `f`
+    /// (eqs 37/39).
+    pub fn half_length<const D: usize>(self, r0: &SVector<f64, D>, f: &Matrix3<f64>) -> SVector<f64, D> {
+        match self {
+            DomainUpdate::Stretch => {
+                let u = stretch_tensor(f);
+                SVector::<f64, D>::from_fn(|a, _| r0[a] * u[(a, a)])
+            }
+            DomainUpdate::FDiagonal => SVector::<f64, D>::from_fn(|a, _| r0[a] * f[(a, a)]),
+            DomainUpdate::Fixed => *r0,
+        }
+    }
+}
+
+/// Which configuration a family's weights live in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Configuration {
+    /// The start of each load step (updated Lagrangian): weights from the current state.
+    Updated,
+    /// The reference configuration (total Lagrangian): weights of the initial state.
+    Total,
+}
+
+/// What a family may read of one material point.
+#[derive(Debug, Clone, Copy)]
+pub struct PointView<'a, const D: usize> {
+    /// Position x_p at the start of the step.
+    pub position: &'a SVector<f64, D>,
+    /// Domain half-lengths l_p / 2 at the start of the step.
+    pub half_length: &'a SVector<f64, D>,
+    /// Initial position X_p.
+    pub position0: &'a SVector<f64, D>,
+    /// Initial half-lengths.
+    pub half_length0: &'a SVector<f64, D>,
+    /// Committed deformation gradient F (3×3; plane strain and 1D fill the unused axes).
+    pub f: &'a Matrix3<f64>,
+    /// Domain corners (2^D, axis 0 fastest) for families that track them; empty otherwise.
+    pub corners: &'a [SVector<f64, D>],
+}
+
+impl<'a, const D: usize> PointView<'a, D> {
+    /// The same point in its reference configuration (undeformed, at X_p).
+    pub fn reference(&self) -> PointView<'a, D> {
+        PointView {
+            position: self.position0,
+            half_length: self.half_length0,
+            position0: self.position0,
+            half_length0: self.half_length0,
+            f: &IDENTITY,
+            corners: &[],
+        }
+    }
+}
+
+/// A D×D matrix (D ≤ 3) embedded in the identity 3×3: its determinant and inverse are those
+/// of the block.
+pub fn padded<const D: usize>(m: &nalgebra::SMatrix<f64, D, D>) -> Matrix3<f64> {
+    let mut out = Matrix3::identity();
+    for i in 0..D {
+        for j in 0..D {
+            out[(i, j)] = m[(i, j)];
+        }
+    }
+    out
+}
+
+/// The D×D block of a 3×3 matrix.
+pub fn block<const D: usize>(m: &Matrix3<f64>) -> nalgebra::SMatrix<f64, D, D> {
+    nalgebra::SMatrix::<f64, D, D>::from_fn(|i, j| m[(i, j)])
+}
+
+static IDENTITY: Matrix3<f64> = Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+
+/// The nodes one point touches, with S_vp and ∂S_vp/∂x: a fixed-capacity list, so that
+/// evaluation allocates nothing.
+#[derive(Debug, Clone)]
+pub struct PointSupport<const D: usize> {
+    len: usize,
+    nodes: [usize; MAX_POINT_NODES],
+    w: [f64; MAX_POINT_NODES],
+    g: [SVector<f64, D>; MAX_POINT_NODES],
+}
+
+impl<const D: usize> Default for PointSupport<D> {
+    fn default() -> Self {
+        Self {
+            len: 0,
+            nodes: [0; MAX_POINT_NODES],
+            w: [0.0; MAX_POINT_NODES],
+            g: [SVector::<f64, D>::zeros(); MAX_POINT_NODES],
+        }
+    }
+}
+
+impl<const D: usize> PointSupport<D> {
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+    pub fn len(&self) -> usize {
+        self.len
+    }
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+    /// Append a node (the caller guarantees it is not yet listed).
+    #[inline]
+    pub fn push(&mut self, node: usize, w: f64, g: SVector<f64, D>) {
+        assert!(
+            self.len < MAX_POINT_NODES,
+            "point support exceeds MAX_POINT_NODES"
+        );
+        self.nodes[self.len] = node;
+        self.w[self.len] = w;
+        self.g[self.len] = g;
+        self.len += 1;
+    }
+    /// Add to a node's weight and gradient, listing it if new.
+    #[inline]
+    pub fn accumulate(&mut self, node: usize, w: f64, g: SVector<f64, D>) {
+        if let Some(k) = self.nodes[..self.len].iter().position(|&n| n == node) {
+            self.w[k] += w;
+            self.g[k] += g;
+        } else {
+            self.push(node, w, g);
+        }
+    }
+    /// Local node `k`: (flat grid node, S_vp, ∂S_vp/∂x).
+    #[inline]
+    pub fn node(&self, k: usize) -> (usize, f64, SVector<f64, D>) {
+        (self.nodes[k], self.w[k], self.g[k])
+    }
+    pub fn nodes(&self) -> &[usize] {
+        &self.nodes[..self.len]
+    }
+    pub fn weights(&self) -> &[f64] {
+        &self.w[..self.len]
+    }
+    pub fn gradients(&self) -> &[SVector<f64, D>] {
+        &self.g[..self.len]
+    }
+    pub fn gradients_mut(&mut self) -> &mut [SVector<f64, D>] {
+        &mut self.g[..self.len]
+    }
+}
+
+/// One axis of a tensor-product family.
+pub trait AxisKernel: Sync + Send {
+    /// Nodes a point with a cell-sized domain touches along the axis, in general position.
+    fn support_nodes(&self) -> usize;
+    /// True if the kernel integrates over the point's domain x ± r (GIMP); false for
+    /// point-evaluated kernels, whose `r` is ignored.
+    fn has_domain(&self) -> bool {
+        false
+    }
+    /// Weights along one grid axis for a point at `x` whose domain half-length is `r`.
+    fn axis_weights(&self, axis: GridAxis, x: f64, r: f64, out: &mut AxisWeights) -> Result<(), BasisError>;
+}
+
+/// The contract of a basis family in `D` dimensions.
+pub trait BasisFamily<const D: usize>: Sync + Send {
+    /// Nodes per axis a point with a cell-sized domain touches, in general position (the
+    /// support width: 2 for MPM, 3 for GIMP, CPDI and quadratic splines, 4 for cubic).
+    fn support_nodes(&self) -> usize;
+
+    /// The configuration the weights live in.
+    fn configuration(&self) -> Configuration {
+        Configuration::Updated
+    }
+
+    /// True if the family tracks domain corners ([`PointView::corners`]).
+    fn needs_corners(&self) -> bool {
+        false
+    }
+
+    /// S_vp and ∂S_vp/∂x on the start-of-step configuration of one point.
+    fn evaluate(
+        &self,
+        grid: &Grid<D>,
+        point: &PointView<'_, D>,
+        out: &mut PointSupport<D>,
+    ) -> Result<(), BasisError>;
+
+    /// The box (lower, upper corner) whose overlap with each cell counts as the point's
+    /// material there for the ghost penalty's cell fill; `None`: all of it in the cell holding
+    /// the point.
+    fn fill_box(&self, point: &PointView<'_, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)>;
+
+    /// Move tracked corners with a converged nodal increment (families that track them).
+    fn update_corners(
+        &self,
+        _grid: &Grid<D>,
+        _du_nodal: &[f64],
+        _corners: &mut [SVector<f64, D>],
+    ) -> Result<(), BasisError> {
+        Ok(())
+    }
+}
+
+/// A tensor product of one axis kernel (the same along every axis).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TensorProduct<K>(pub K);
+
+impl<K: AxisKernel> TensorProduct<K> {
+    /// The per-axis weights of a point at `x` with half-lengths `r`.
+    pub fn axes<const D: usize>(
+        &self,
+        grid: &Grid<D>,
+        x: &SVector<f64, D>,
+        r: &SVector<f64, D>,
+        out: &mut Support<D>,
+    ) -> Result<(), BasisError> {
+        for a in 0..D {
+            self.0
+                .axis_weights(GridAxis::of(grid, a), x[a], r[a], &mut out.axes[a])?;
+        }
+        Ok(())
+    }
+}
+
+impl<const D: usize, K: AxisKernel> BasisFamily<D> for TensorProduct<K> {
+    fn support_nodes(&self) -> usize {
+        self.0.support_nodes()
+    }
+
+    fn evaluate(
+        &self,
+        grid: &Grid<D>,
+        point: &PointView<'_, D>,
+        out: &mut PointSupport<D>,
+    ) -> Result<(), BasisError> {
+        let mut axes = Support::<D>::default();
+        self.axes(grid, point.position, point.half_length, &mut axes)?;
+        out.clear();
+        for k in 0..axes.len() {
+            let (node, s, g) = axes.node(grid, k);
+            out.push(node, s, g);
+        }
+        Ok(())
+    }
+
+    fn fill_box(&self, point: &PointView<'_, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+        self.0.has_domain().then(|| {
+            (
+                point.position - point.half_length,
+                point.position + point.half_length,
+            )
+        })
+    }
+}
+
+/// Which basis family a material point solver uses. The serialised names are the families'
+/// method names apart from GIMP's (`gimp`; the method is `igimp`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize, Hash)]
+#[serde(rename_all = "lowercase")]
+pub enum Basis {
+    /// Standard MPM: linear shape functions evaluated at the point, χ_p = δ V_p (eq 5).
+    Mpm,
+    /// GIMP with a top-hat characteristic function (eq 6), split per element (eqs 7–10).
+    Gimp,
+    /// CPDI2: corner-tracked multilinear domains ([`cpdi`]).
+    Cpdi,
+    /// Quadratic B-splines, boundary nodes by linear extrapolation ([`bspline`]).
+    Bspline2,
+    /// Cubic B-splines, boundary nodes by linear extrapolation ([`bspline`]).
+    Bspline3,
+    /// Total-Lagrangian MPM: linear hats in the reference configuration ([`total_lagrangian`]).
+    Tlmpm,
+}
+
+const MPM: TensorProduct<LinearKernel> = TensorProduct(LinearKernel);
+const GIMP: TensorProduct<GimpKernel> = TensorProduct(GimpKernel);
+const BSPLINE2: TensorProduct<BsplineKernel> = TensorProduct(BsplineKernel {
+    degree: SplineDegree::Quadratic,
+    boundary: SplineBoundary::LinearExtrapolation,
+});
+const BSPLINE3: TensorProduct<BsplineKernel> = TensorProduct(BsplineKernel {
+    degree: SplineDegree::Cubic,
+    boundary: SplineBoundary::LinearExtrapolation,
+});
+const TLMPM: TotalLagrangian<TensorProduct<LinearKernel>> = TotalLagrangian(TensorProduct(LinearKernel));
+
+impl Basis {
+    /// Every family, in declaration order.
+    pub const ALL: [Basis; 6] = [
+        Basis::Mpm,
+        Basis::Gimp,
+        Basis::Cpdi,
+        Basis::Bspline2,
+        Basis::Bspline3,
+        Basis::Tlmpm,
+    ];
+
+    /// The family's implementation in `D` dimensions.
+    pub fn family<const D: usize>(self) -> &'static dyn BasisFamily<D> {
+        match self {
+            Basis::Mpm => &MPM,
+            Basis::Gimp => &GIMP,
+            Basis::Cpdi => &Cpdi,
+            Basis::Bspline2 => &BSPLINE2,
+            Basis::Bspline3 => &BSPLINE3,
+            Basis::Tlmpm => &TLMPM,
+        }
+    }
+
+    /// The axis kernel of a tensor-product family; `None` for CPDI and TLMPM.
+    pub fn axis_kernel(self) -> Option<&'static dyn AxisKernel> {
+        match self {
+            Basis::Mpm => Some(&LinearKernel),
+            Basis::Gimp => Some(&GimpKernel),
+            Basis::Bspline2 => Some(&BSPLINE2.0),
+            Basis::Bspline3 => Some(&BSPLINE3.0),
+            Basis::Cpdi | Basis::Tlmpm => None,
+        }
+    }
+
+    /// The name of the method in study files and `results.json`.
+    pub fn method_name(self) -> &'static str {
+        match self {
+            Basis::Mpm => "mpm",
+            Basis::Gimp => "igimp",
+            Basis::Cpdi => "cpdi",
+            Basis::Bspline2 => "bspline2",
+            Basis::Bspline3 => "bspline3",
+            Basis::Tlmpm => "tlmpm",
+        }
+    }
+
+    /// The human name.
+    pub fn label(self) -> &'static str {
+        match self {
+            Basis::Mpm => "MPM",
+            Basis::Gimp => "iGIMP",
+            Basis::Cpdi => "CPDI2",
+            Basis::Bspline2 => "quadratic B-spline MPM",
+            Basis::Bspline3 => "cubic B-spline MPM",
+            Basis::Tlmpm => "TLMPM",
+        }
+    }
+
+    /// True if the family's weights depend on the domain half-lengths, and so on the domain
+    /// update rule (GIMP only; CPDI's domains follow their corners).
+    pub fn uses_domain_update(self) -> bool {
+        self.axis_kernel().is_some_and(|k| k.has_domain())
+    }
+
+    /// Weights along one grid axis for a point at `x` whose domain half-length is `r`
+    /// (ignored by point-evaluated kernels); tensor-product families only.
+    pub fn axis_weights(
+        self,
+        grid_axis: GridAxis,
+        x: f64,
+        r: f64,
+        out: &mut AxisWeights,
+    ) -> Result<(), BasisError> {
+        self.axis_kernel()
+            .ok_or(BasisError::NotTensorProduct)?
+            .axis_weights(grid_axis, x, r, out)
+    }
+
+    /// Per-axis weights of a point at `x` with domain half-lengths `r` on `grid`
+    /// (tensor-product families only).
+    pub fn evaluate<const D: usize>(
+        self,
+        grid: &Grid<D>,
+        x: &SVector<f64, D>,
+        r: &SVector<f64, D>,
+        out: &mut Support<D>,
+    ) -> Result<(), BasisError> {
+        for a in 0..D {
+            self.axis_weights(GridAxis::of(grid, a), x[a], r[a], &mut out.axes[a])?;
+        }
+        Ok(())
+    }
+}
+
+/// Tensor-product support of one point: the nodes it touches with their weights and gradients.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Support<const D: usize> {
+    pub axes: [AxisWeights; D],
+}
+
+impl<const D: usize> Default for Support<D> {
+    fn default() -> Self {
+        Self {
+            axes: [AxisWeights::default(); D],
+        }
+    }
+}
+
+impl<const D: usize> Support<D> {
+    /// Number of nodes in the tensor-product support.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.axes.iter().map(|a| a.len).product()
+    }
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Per-axis local indices of local node `k` (axis 0 fastest).
+    #[inline]
+    fn local(&self, mut k: usize) -> [usize; D] {
+        let mut idx = [0; D];
+        for (a, i) in idx.iter_mut().enumerate() {
+            *i = k % self.axes[a].len;
+            k /= self.axes[a].len;
+        }
+        idx
+    }
+    /// Local node `k`: (flat grid node, S_vp, ∂S_vp/∂x).
+    #[inline]
+    pub fn node(&self, grid: &Grid<D>, k: usize) -> (usize, f64, SVector<f64, D>) {
+        let loc = self.local(k);
+        let mut gidx = [0; D];
+        let mut s = 1.0;
+        let mut g = SVector::<f64, D>::repeat(1.0);
+        for a in 0..D {
+            let ax = &self.axes[a];
+            gidx[a] = ax.first + loc[a];
+            s *= ax.w[loc[a]];
+            for b in 0..D {
+                g[b] *= if a == b { ax.dw[loc[a]] } else { ax.w[loc[a]] };
+            }
+        }
+        (grid.node_index(gidx), s, g)
+    }
+}
