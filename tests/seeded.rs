@@ -11,6 +11,10 @@
 //! | V_p without det ΔF (eq 28) | the manufactured study's rate bands |
 //! | stress error at x_p instead of X_p | the iGIMP stress-rate band (1.64 ± 0.25) |
 //! | GIMP weights without the per-element split (eqs 7–10) | weights against direct quadrature of ∫χ_p N_v, and the rate bands |
+//! | multigrid prolongation with its two weights swapped | CG iterations per solve (≤ 20) and no fallback |
+//! | B-splines without their boundary treatment | partition of unity within 1.5h of the grid's edge |
+//! | CPDI corners moved against the grid | the column study's CPDI rate bands |
+//! | TLMPM with ∇₀S as the start-of-step gradient (no Fₙ⁻ᵀ) | the column study's TLMPM rate bands |
 
 use igimp::method::Method;
 use igimp::newton::check_quadratic;
@@ -21,8 +25,17 @@ use igimp::study::manufactured::ManufacturedStudy;
 use igimp::study::Tier;
 use std::path::Path;
 
+/// The manufactured study without its other-family sweeps (the bugs here are iGIMP's; the
+/// families' own bugs are caught on the column, which is much cheaper).
 fn study() -> ManufacturedStudy {
-    ManufacturedStudy::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/manufactured.toml")).unwrap()
+    let mut s =
+        ManufacturedStudy::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/manufactured.toml"))
+            .unwrap();
+    let family = |id: &str| id.ends_with("-families");
+    s.sweeps.retain(|x| !family(&x.id));
+    s.expect_rate.retain(|x| !family(&x.sweep));
+    s.figures.retain(|x| !family(&x.sweep));
+    s
 }
 
 /// (passed, failed, not evaluated) of the manufactured quick tier's rate checks, and the ids
@@ -144,6 +157,50 @@ fn multigrid_iterations() -> (f64, usize) {
     )
 }
 
+/// Worst |Σ S − 1| of the quadratic and cubic B-splines over points within 1.5h of the
+/// grid's lower edge (2D, unit cells).
+fn spline_unity_defect() -> f64 {
+    use igimp::basis::{Basis, PointSupport, PointView};
+    use igimp::grid::Grid;
+    use nalgebra::{Matrix3, SVector};
+    let grid = Grid::<2>::try_new([0.0; 2], [1.0; 2], [6; 2]).unwrap();
+    let mut sup = PointSupport::<2>::default();
+    let mut worst: f64 = 0.0;
+    for basis in [Basis::Bspline2, Basis::Bspline3] {
+        for i in 0..=30 {
+            let x = SVector::<f64, 2>::new(0.05 * i as f64, 3.3);
+            let r = SVector::<f64, 2>::repeat(0.25);
+            let f = Matrix3::identity();
+            let view = PointView {
+                position: &x,
+                half_length: &r,
+                position0: &x,
+                half_length0: &r,
+                f: &f,
+                corners: &[],
+            };
+            basis.family::<2>().evaluate(&grid, &view, &mut sup).unwrap();
+            worst = worst.max((sup.weights().iter().sum::<f64>() - 1.0).abs());
+        }
+    }
+    worst
+}
+
+/// The ids of the column quick tier's checks that did not pass.
+fn column_bad_checks() -> Vec<String> {
+    use igimp::study::column::StudySpec;
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/column.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let study = StudySpec::parse(&text, "column.toml").unwrap();
+    let run = run_in_memory(&study, "column.toml", Tier::Quick).unwrap();
+    run.results
+        .checks
+        .iter()
+        .filter(|c| c.pass != Some(true))
+        .map(|c| c.id.clone())
+        .collect()
+}
+
 #[test]
 fn every_seeded_bug_is_caught() {
     // The correct kernels pass everything the variants must fail.
@@ -162,6 +219,10 @@ fn every_seeded_bug_is_caught() {
         its <= 20.0 && fallbacks == 0,
         "correct multigrid: {its} iterations per solve, {fallbacks} fallbacks"
     );
+    let d = spline_unity_defect();
+    assert!(d < 1e-12, "correct B-splines: |ΣS − 1| = {d:e}");
+    let bad = column_bad_checks();
+    assert!(bad.is_empty(), "correct kernels: column checks {bad:?}");
     eprintln!("control: 14/14 rate checks pass, Newton quadratic, stress rate {rate:.2}, GIMP weights within {w:.1e} of the quadrature");
 
     // 1. No geometric term: the solution is unchanged, so the rate bands cannot see it, but
@@ -201,6 +262,27 @@ fn every_seeded_bug_is_caught() {
         its > 20.0 || fallbacks > 0,
         "a swapped prolongation passed the multigrid iteration bound"
     );
+    set(Bug::None);
+
+    // 7. B-splines without their boundary treatment: Σ S = 1 fails near the edge.
+    set(Bug::SplineWithoutBoundary);
+    let d = spline_unity_defect();
+    eprintln!("splines without boundary treatment: |ΣS − 1| up to {d:.3e}");
+    assert!(d > 1e-2, "splines without boundary treatment passed: {d:e}");
+
+    // 8, 9. CPDI corners against the grid, TLMPM without Fₙ⁻ᵀ: the column's family bands.
+    for (bug, family) in [
+        (Bug::CornersAgainstGrid, "cpdi"),
+        (Bug::ReferenceGradients, "tlmpm"),
+    ] {
+        set(bug);
+        let bad = column_bad_checks();
+        eprintln!("{bug:?}: column checks failing: {bad:?}");
+        assert!(
+            bad.iter().any(|id| id.contains(family)),
+            "{bug:?} passed every {family} band of the column"
+        );
+    }
     set(Bug::None);
 
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.

@@ -77,7 +77,11 @@ fn column_dimension_is_validated() {
     )
     .unwrap_err();
     assert_eq!(e.field, "dimension");
-    assert!(e.allowed.contains("mpm, igimp, cpdi, bspline2, bspline3, tlmpm, fem-hex8, fem-hex20"), "{e}");
+    assert!(
+        e.allowed
+            .contains("mpm, igimp, cpdi, bspline2, bspline3, tlmpm, fem-hex8, fem-hex20"),
+        "{e}"
+    );
     // The 3D elements are not 1D methods.
     let e = solve_column(&ColumnSpec::default(), Method::FEM_HEX8).unwrap_err();
     assert_eq!(e.field, "dimension");

@@ -26,14 +26,14 @@ fn quick() -> &'static Run<ManufacturedStudy> {
     })
 }
 
-/// The quick tier's 14 rate checks (Q4, Q8 at their textbook orders; iGIMP at its measured
-/// slopes) are all evaluated and all pass; each FEM series converged at every level.
+/// The quick tier's 22 rate checks (Q4, Q8 at their textbook orders; iGIMP, CPDI2 and TLMPM
+/// at their measured slopes) are all evaluated and all pass; each FEM series converged at every level.
 #[test]
 fn every_expected_rate_is_inside_its_band() {
     let r = &quick().results;
     assert_eq!(
         r.checks.len(),
-        14,
+        22,
         "{:?}",
         r.checks.iter().map(|c| &c.id).collect::<Vec<_>>()
     );
@@ -101,7 +101,7 @@ fn manufactured_outputs_rerender_byte_identically() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = write_outputs(tmp.path(), quick()).unwrap();
     let first = render(&dir).unwrap().files;
-    assert_eq!(first.len(), 7, "{first:?}");
+    assert_eq!(first.len(), 9, "{first:?}");
     let bytes: Vec<Vec<u8>> = first.iter().map(|p| std::fs::read(p).unwrap()).collect();
     for p in &first {
         std::fs::remove_file(p).unwrap();
