@@ -163,9 +163,9 @@ fn truncated_splines_fail_the_invariants_near_the_edge() {
 }
 
 /// CPDI2's 2D weights against the closed forms of Sadeghirad, Brannon & Guilkey (2013) for a
-/// quadrilateral with corners 1-4 counter-clockwise: V by the shoelace formula and
-/// w^g_α = (1/2V) (y_{α+1} − y_{α−1}, x_{α−1} − x_{α+1}); w^f through the centroid it must
-/// reproduce.
+/// quadrilateral with corners 1-4 counter-clockwise: V by the shoelace formula,
+/// w^f_α = (6V ∓ a ∓ b)/(24V) and w^g_α = (1/2V) (y_{α+1} − y_{α−1}, x_{α−1} − x_{α+1}); w^f also
+/// through the centroid it must reproduce.
 #[test]
 fn cpdi2_weights_match_the_closed_form_on_a_quadrilateral() {
     let mut rng = Rng::new(5);
@@ -201,7 +201,27 @@ fn cpdi2_weights_match_the_closed_form_on_a_quadrilateral() {
                 wg[mine]
             );
         }
-        // w^f through what it must give: Σ w^f x_α = (1/V)∫x dΩ, the polygon's centroid.
+        // w^f against its closed form, (6V ∓ a ∓ b)/(24V) (as in Nguyen's mpmat,
+        // basis/getCPDIQuadData.m, after Sadeghirad et al. 2013), and through what it must
+        // give: Σ w^f x_α = (1/V)∫x dΩ, the polygon's centroid.
+        let a = (x(3) - x(0)) * (y(1) - y(2)) - (x(1) - x(2)) * (y(3) - y(0));
+        let b = (x(2) - x(3)) * (y(0) - y(1)) - (x(0) - x(1)) * (y(2) - y(3));
+        let closed = [
+            6.0 * area - a - b,
+            6.0 * area - a + b,
+            6.0 * area + a + b,
+            6.0 * area + a - b,
+        ]
+        .map(|w| w / (24.0 * area));
+        for (paper, mine) in [(0usize, 0usize), (1, 1), (2, 3), (3, 2)] {
+            assert!(
+                (wf[mine] - closed[paper]).abs() < 1e-12,
+                "w^f of corner {}: {} against {}",
+                paper + 1,
+                wf[mine],
+                closed[paper]
+            );
+        }
         let cx: f64 = (0..4).map(|i| wf[i] * ours[i][0]).sum();
         let cy: f64 = (0..4).map(|i| wf[i] * ours[i][1]).sum();
         let (mut ax, mut ay) = (0.0, 0.0);
