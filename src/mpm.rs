@@ -11,6 +11,7 @@ use crate::newton::NewtonSettings;
 use crate::particles::MaterialPoints;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 pub use crate::basis::DomainUpdate;
 
@@ -112,6 +113,42 @@ pub struct MpmSolver<const D: usize> {
     step: usize,
     work: StepWorkspace<D>,
     ghost: GhostOperator<D>,
+    /// The basis family: `settings.basis`'s, or one given by [`Self::with_family`].
+    family: Arc<dyn BasisFamily<D>>,
+}
+
+/// A built-in family as a shared one.
+struct BuiltIn(Basis);
+
+impl<const D: usize> BasisFamily<D> for BuiltIn {
+    fn support_nodes(&self) -> usize {
+        self.0.family::<D>().support_nodes()
+    }
+    fn configuration(&self) -> crate::basis::Configuration {
+        self.0.family::<D>().configuration()
+    }
+    fn needs_corners(&self) -> bool {
+        self.0.family::<D>().needs_corners()
+    }
+    fn evaluate(
+        &self,
+        grid: &Grid<D>,
+        point: &crate::basis::PointView<'_, D>,
+        out: &mut PointSupport<D>,
+    ) -> Result<(), BasisError> {
+        self.0.family::<D>().evaluate(grid, point, out)
+    }
+    fn fill_box(&self, point: &crate::basis::PointView<'_, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+        self.0.family::<D>().fill_box(point)
+    }
+    fn update_corners(
+        &self,
+        grid: &Grid<D>,
+        du_nodal: &[f64],
+        corners: &mut [SVector<f64, D>],
+    ) -> Result<(), BasisError> {
+        self.0.family::<D>().update_corners(grid, du_nodal, corners)
+    }
 }
 
 impl<const D: usize> MpmSolver<D> {
@@ -165,6 +202,7 @@ impl<const D: usize> MpmSolver<D> {
         if settings.basis.family::<D>().needs_corners() {
             points.track_corners();
         }
+        let family: Arc<dyn BasisFamily<D>> = Arc::new(BuiltIn(settings.basis));
         Ok(Self {
             grid,
             points,
@@ -175,7 +213,19 @@ impl<const D: usize> MpmSolver<D> {
             step: 0,
             work: StepWorkspace::default(),
             ghost: GhostOperator::default(),
+            family,
         })
+    }
+
+    /// The solver with a basis family of the caller's instead of `settings.basis`'s (e.g. one
+    /// defined outside this crate against [`BasisFamily`]; `examples/custom_basis.rs`).
+    /// `settings.basis` then only names the run.
+    pub fn with_family(mut self, family: Arc<dyn BasisFamily<D>>) -> Self {
+        if family.needs_corners() {
+            self.points.track_corners();
+        }
+        self.family = family;
+        self
     }
 
     /// The constitutive model.
@@ -203,8 +253,8 @@ impl<const D: usize> MpmSolver<D> {
     }
 
     /// The basis family of the settings.
-    fn family(&self) -> &'static dyn BasisFamily<D> {
-        self.settings.basis.family::<D>()
+    fn family(&self) -> Arc<dyn BasisFamily<D>> {
+        Arc::clone(&self.family)
     }
 
     fn build_supports_untimed(&mut self) -> Result<(), StepFailure> {
@@ -253,7 +303,7 @@ impl<const D: usize> MpmSolver<D> {
     pub fn build_ghost(&mut self) {
         let start = std::time::Instant::now();
         if self.settings.ghost.is_on() {
-            cell_fill(&self.grid, self.family(), &self.points, self.ghost.fill_mut());
+            cell_fill(&self.grid, &*self.family, &self.points, self.ghost.fill_mut());
         }
         if self.settings.ghost.is_on() && self.settings.ghost.cut_share > 0.0 {
             node_share(

@@ -5,6 +5,10 @@
 
 mod common;
 
+/// The extension example, run by `families`.
+#[path = "../../examples/custom_basis.rs"]
+mod custom_basis;
+
 mod basis;
 mod column;
 mod compaction;
