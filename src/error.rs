@@ -39,7 +39,7 @@ pub fn shortest(x: f64) -> String {
 /// digits) are rewritten in their shortest round-trip form (`1e300`, `1e-300`).
 const LONGEST_PLAIN_NUMBER: usize = 24;
 
-/// `text` with every number longer than [`LONGEST_PLAIN_NUMBER`] characters in shortest
+/// `text` with every number longer than `LONGEST_PLAIN_NUMBER` characters in shortest
 /// round-trip form, so that an extreme input gives a readable message.
 pub fn tidy_numbers(text: &str) -> String {
     let mut out = String::with_capacity(text.len());

@@ -261,7 +261,7 @@ pub fn solve(
     ))
 }
 
-/// A step whose Newton iterations are used up, stalled ([`detect_stall`]) at a floor within
+/// A step whose Newton iterations are used up, stalled (`detect_stall`) at a floor within
 /// this factor of the tolerance — and whose last residual is too — is accepted and recorded
 /// as such ([`NewtonReport::accepted_floor`]); a floor further above is a failure. The floor
 /// is round-off in `f_int − f_ext` and grows like the tangent's condition number
