@@ -117,40 +117,6 @@ pub struct MpmSolver<const D: usize> {
     family: Arc<dyn BasisFamily<D>>,
 }
 
-/// A built-in family as a shared one.
-struct BuiltIn(Basis);
-
-impl<const D: usize> BasisFamily<D> for BuiltIn {
-    fn support_nodes(&self) -> usize {
-        self.0.family::<D>().support_nodes()
-    }
-    fn configuration(&self) -> crate::basis::Configuration {
-        self.0.family::<D>().configuration()
-    }
-    fn needs_corners(&self) -> bool {
-        self.0.family::<D>().needs_corners()
-    }
-    fn evaluate(
-        &self,
-        grid: &Grid<D>,
-        point: &crate::basis::PointView<'_, D>,
-        out: &mut PointSupport<D>,
-    ) -> Result<(), BasisError> {
-        self.0.family::<D>().evaluate(grid, point, out)
-    }
-    fn fill_box(&self, point: &crate::basis::PointView<'_, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
-        self.0.family::<D>().fill_box(point)
-    }
-    fn update_corners(
-        &self,
-        grid: &Grid<D>,
-        du_nodal: &[f64],
-        corners: &mut [SVector<f64, D>],
-    ) -> Result<(), BasisError> {
-        self.0.family::<D>().update_corners(grid, du_nodal, corners)
-    }
-}
-
 impl<const D: usize> MpmSolver<D> {
     pub fn try_new(
         grid: Grid<D>,
@@ -198,11 +164,11 @@ impl<const D: usize> MpmSolver<D> {
                 ));
             }
         }
+        let family = settings.basis.shared::<D>();
         let mut points = points;
-        if settings.basis.family::<D>().needs_corners() {
+        if family.needs_corners() {
             points.track_corners();
         }
-        let family: Arc<dyn BasisFamily<D>> = Arc::new(BuiltIn(settings.basis));
         Ok(Self {
             grid,
             points,
@@ -252,7 +218,8 @@ impl<const D: usize> MpmSolver<D> {
         crate::profile::timed(crate::profile::Phase::Weights, || self.build_supports_untimed())
     }
 
-    /// The basis family of the settings.
+    /// The solver's basis family (shared, so that it can be used while the solver's fields are
+    /// borrowed mutably).
     fn family(&self) -> Arc<dyn BasisFamily<D>> {
         Arc::clone(&self.family)
     }

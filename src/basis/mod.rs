@@ -423,6 +423,19 @@ impl Basis {
         }
     }
 
+    /// [`Self::family`] as a shared value, the form the solver holds (it also holds families
+    /// defined outside the crate).
+    pub fn shared<const D: usize>(self) -> std::sync::Arc<dyn BasisFamily<D>> {
+        match self {
+            Basis::Mpm => std::sync::Arc::new(MPM),
+            Basis::Gimp => std::sync::Arc::new(GIMP),
+            Basis::Cpdi => std::sync::Arc::new(Cpdi),
+            Basis::Bspline2 => std::sync::Arc::new(BSPLINE2),
+            Basis::Bspline3 => std::sync::Arc::new(BSPLINE3),
+            Basis::Tlmpm => std::sync::Arc::new(TLMPM),
+        }
+    }
+
     /// The axis kernel of a tensor-product family; `None` for CPDI and TLMPM.
     pub fn axis_kernel(self) -> Option<&'static dyn AxisKernel> {
         match self {
