@@ -1,6 +1,9 @@
 //! Speed of the solver core, sizes from `benches/sizes.toml`:
 //! - `column_load_step`: one load step of the W = 400,000 column (2 points per element);
 //! - `weights`: MPM and GIMP weights and gradients of many points (1D, 2D);
+//! - `families_2d`, `families_3d`: every basis family's weights, and weights + per-point tangent
+//!   blocks per node pair (throughput in node pairs per second: the per-pair cost against
+//!   iGIMP's is what the support ratio bounds);
 //! - `point_kernel`: kinematics + constitutive update + spatial tangent of one point, linear
 //!   elastic and von Mises (plastic return);
 //! - `assembly`: residual and tangent of a plane-strain Q4 mesh;
@@ -8,8 +11,8 @@
 //!
 //! `cargo bench --bench solver`
 
-use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
-use igimp::basis::{Basis, Support};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
+use igimp::basis::{Basis, PointSupport, PointView, Support};
 use igimp::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
 use igimp::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
 use igimp::grid::Grid;
@@ -18,7 +21,7 @@ use igimp::linear::LinearSolver;
 use igimp::load_stepping::LoadStepping;
 use igimp::newton::NonlinearSystem;
 use igimp::problems::column::ColumnSpec;
-use nalgebra::{SMatrix, SVector};
+use nalgebra::{Matrix3, SMatrix, SVector};
 use serde::Deserialize;
 use std::hint::black_box;
 
@@ -26,6 +29,7 @@ use std::hint::black_box;
 struct Sizes {
     load_step: LoadStepSizes,
     weights: WeightSizes,
+    families: FamilySizes,
     assembly: MeshSizes,
     factorisation: FactorSizes,
 }
@@ -37,6 +41,15 @@ struct LoadStepSizes {
 struct WeightSizes {
     points: usize,
     cells: usize,
+}
+#[derive(Deserialize)]
+struct FamilySizes {
+    cells_2d: usize,
+    cells_3d: usize,
+    weight_points_2d: usize,
+    weight_points_3d: usize,
+    tangent_points_2d: usize,
+    tangent_points_3d: usize,
 }
 #[derive(Deserialize)]
 struct MeshSizes {
@@ -112,6 +125,131 @@ fn weights(c: &mut Criterion) {
     let s = sizes().weights;
     weights_of::<1>(c, s.points, s.cells);
     weights_of::<2>(c, s.points, s.cells);
+}
+
+/// `n` seeded points of `grid` (unit cells) at least a cell from its edges: half-lengths a
+/// quarter cell, a sheared F, box corners moved by a tenth of the half-lengths.
+struct FamilyPoints<const D: usize> {
+    x: Vec<SVector<f64, D>>,
+    r: SVector<f64, D>,
+    f: Matrix3<f64>,
+    corners: Vec<Vec<SVector<f64, D>>>,
+}
+
+fn family_points<const D: usize>(n: usize, cells: usize) -> FamilyPoints<D> {
+    let r = SVector::<f64, D>::repeat(0.25);
+    let x: Vec<SVector<f64, D>> = (0..n)
+        .map(|p| {
+            SVector::<f64, D>::from_fn(|a, _| {
+                let t = ((p * (a + 1)) as f64 * 0.618_033_988_75).fract();
+                1.5 + t * (cells as f64 - 3.0)
+            })
+        })
+        .collect();
+    let corners = x
+        .iter()
+        .enumerate()
+        .map(|(p, x)| {
+            let mut c = vec![];
+            igimp::basis::cpdi::box_corners(x, &r, &mut c);
+            for (k, v) in c.iter_mut().enumerate() {
+                for a in 0..D {
+                    v[a] += 0.1 * r[a] * (((p + 7 * k + 3 * a) as f64 * 0.754_877_666).fract() - 0.5);
+                }
+            }
+            c
+        })
+        .collect();
+    let mut f = Matrix3::identity();
+    f[(0, 1)] = 0.1;
+    f[(1, 0)] = -0.05;
+    FamilyPoints { x, r, f, corners }
+}
+
+/// Σ over a point's node pairs of g_aᵀ A g_b (A: a fixed D²×D² spatial tangent), the dense
+/// per-pair work of the tangent assembly without the scatter.
+#[inline]
+fn tangent_blocks<const D: usize>(sup: &PointSupport<D>, a: &[[f64; 9]; 9]) -> f64 {
+    let mut acc = 0.0;
+    for i in 0..sup.len() {
+        let (_, _, ga) = sup.node(i);
+        for j in 0..sup.len() {
+            let (_, _, gb) = sup.node(j);
+            for p in 0..D {
+                for q in 0..D {
+                    let mut k = 0.0;
+                    for s in 0..D {
+                        for t in 0..D {
+                            k += ga[s] * a[p * D + s][q * D + t] * gb[t];
+                        }
+                    }
+                    acc += k;
+                }
+            }
+        }
+    }
+    acc
+}
+
+fn families_of<const D: usize>(c: &mut Criterion, cells: usize, weight_points: usize, tangent_points: usize) {
+    let grid = Grid::<D>::try_new([0.0; D], [1.0; D], [cells; D]).unwrap();
+    let pts = family_points::<D>(weight_points.max(tangent_points), cells);
+    let mut a = [[0.0; 9]; 9];
+    for (i, row) in a.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v = if i == j { 2.0 } else { 0.1 / (1 + i + j) as f64 };
+        }
+    }
+    let mut group = c.benchmark_group(format!("families_{D}d"));
+    group.sample_size(10);
+    for basis in Basis::ALL {
+        let family = basis.family::<D>();
+        let view = |p: usize| PointView {
+            position: &pts.x[p],
+            half_length: &pts.r,
+            position0: &pts.x[p],
+            half_length0: &pts.r,
+            f: &pts.f,
+            corners: &pts.corners[p],
+        };
+        let mut sup = PointSupport::<D>::default();
+        group.throughput(Throughput::Elements(weight_points as u64));
+        group.bench_function(format!("{basis:?}_weights_{weight_points}_points"), |b| {
+            b.iter(|| {
+                for p in 0..weight_points {
+                    family.evaluate(&grid, &view(p), &mut sup).unwrap();
+                    black_box(&sup);
+                }
+            })
+        });
+        let pairs: u64 = (0..tangent_points)
+            .map(|p| {
+                family.evaluate(&grid, &view(p), &mut sup).unwrap();
+                (sup.len() * sup.len()) as u64
+            })
+            .sum();
+        group.throughput(Throughput::Elements(pairs));
+        group.bench_function(
+            format!("{basis:?}_weights_and_tangent_{tangent_points}_points_per_node_pair"),
+            |b| {
+                b.iter(|| {
+                    let mut acc = 0.0;
+                    for p in 0..tangent_points {
+                        family.evaluate(&grid, &view(p), &mut sup).unwrap();
+                        acc += tangent_blocks(&sup, &a);
+                    }
+                    black_box(acc)
+                })
+            },
+        );
+    }
+    group.finish();
+}
+
+fn families(c: &mut Criterion) {
+    let s = sizes().families;
+    families_of::<2>(c, s.cells_2d, s.weight_points_2d, s.tangent_points_2d);
+    families_of::<3>(c, s.cells_3d, s.weight_points_3d, s.tangent_points_3d);
 }
 
 fn point_kernel(c: &mut Criterion) {
@@ -215,6 +353,6 @@ fn factorisation(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = load_step, weights, point_kernel, assembly, factorisation
+    targets = load_step, weights, families, point_kernel, assembly, factorisation
 }
 criterion_main!(benches);

@@ -164,19 +164,61 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
 /// Write `<out>/index.md` linking the reports and figures of every study folder in `out`
 /// that holds a `results.json`.
 pub fn render_index(out: &Path) -> Result<PathBuf, StudyError> {
+    let dirs = study_dirs(out)?;
+    let entries = dirs
+        .iter()
+        .map(|d| index_entry(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut page = render::index_page(&entries);
+    if out.join(METHODS_DIR).join(render::methods::REPORT).is_file() {
+        page.push_str(&format!(
+            "## methods\n\nEvery method side by side, gathered from the studies above: [report]({METHODS_DIR}/{}).\n\n",
+            render::methods::REPORT
+        ));
+    }
+    let p = out.join("index.md");
+    crate::study::store::write_file(&p, page.as_bytes())?;
+    Ok(p)
+}
+
+/// The folder of `out` the cross-method report is written to.
+pub const METHODS_DIR: &str = "methods";
+
+/// The study folders of `out` (those holding a `results.json`), sorted.
+fn study_dirs(out: &Path) -> Result<Vec<PathBuf>, StudyError> {
     let mut dirs: Vec<PathBuf> = std::fs::read_dir(out)
         .map_err(|e| StudyError::io(out, e))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.join("results.json").is_file())
         .collect();
     dirs.sort();
-    let entries = dirs
-        .iter()
-        .map(|d| index_entry(d))
-        .collect::<Result<Vec<_>, _>>()?;
-    let p = out.join("index.md");
-    crate::study::store::write_file(&p, render::index_page(&entries).as_bytes())?;
-    Ok(p)
+    Ok(dirs)
+}
+
+/// Gather every study of `out` into `<out>/methods/methods.json` and render the cross-method
+/// report from it ([`crate::study::methods`]); nothing (`None`) when no study in `out` has
+/// rates or reference comparisons.
+pub fn render_methods(out: &Path) -> Result<Option<Rendered>, StudyError> {
+    let mut studies = vec![];
+    for d in study_dirs(out)? {
+        let v: serde_json::Value = crate::study::results::read_json(&d.join("results.json"))?;
+        let name = d
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        studies.push((name, v));
+    }
+    let gathered = crate::study::methods::collect(&studies);
+    if gathered.rates.is_empty() && gathered.references.is_empty() {
+        return Ok(None);
+    }
+    let dir = out.join(METHODS_DIR);
+    std::fs::create_dir_all(&dir).map_err(|e| StudyError::io(&dir, e))?;
+    let text = serde_json::to_string_pretty(&gathered).map_err(|e| StudyError::Io {
+        path: dir.join(render::methods::RESULTS).display().to_string(),
+        message: e.to_string(),
+    })?;
+    crate::study::store::write_file(&dir.join(render::methods::RESULTS), text.as_bytes())?;
+    render::methods::render(&dir).map(Some)
 }
 
 /// (name, summary) of a study file for `study list`.

@@ -282,6 +282,7 @@ impl<const D: usize> MpmSolver<D> {
         }
         self.ghost
             .build(&self.grid, &self.settings.ghost, self.model.young_modulus());
+        self.ghost.retain_reached(&self.work.table);
         crate::profile::charge(crate::profile::Phase::Weights, start);
     }
 

@@ -143,7 +143,11 @@ impl<const D: usize> BasisFamily<D> for Cpdi {
         Ok(())
     }
 
-    fn fill_box(&self, point: &PointView<'_, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+    fn fill_box(
+        &self,
+        _grid: &Grid<D>,
+        point: &PointView<'_, D>,
+    ) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
         let c = point.corners;
         let lo = SVector::<f64, D>::from_fn(|a, _| c.iter().map(|x| x[a]).fold(f64::INFINITY, f64::min));
         let hi = SVector::<f64, D>::from_fn(|a, _| c.iter().map(|x| x[a]).fold(f64::NEG_INFINITY, f64::max));

@@ -273,6 +273,14 @@ pub trait AxisKernel: Sync + Send {
     fn has_domain(&self) -> bool {
         false
     }
+    /// Half-width, along an axis of grid spacing `spacing`, of the box whose overlap with the
+    /// cells counts as a point's material for the ghost penalty's cell fill (`r`: the point's
+    /// domain half-length); `None`: all of it in the cell holding the point. The default is the
+    /// domain for domain kernels and `None` otherwise.
+    fn fill_half_width(&self, spacing: f64, r: f64) -> Option<f64> {
+        let _ = spacing;
+        self.has_domain().then_some(r)
+    }
     /// Weights along one grid axis for a point at `x` whose domain half-length is `r`.
     fn axis_weights(&self, axis: GridAxis, x: f64, r: f64, out: &mut AxisWeights) -> Result<(), BasisError>;
 }
@@ -301,10 +309,16 @@ pub trait BasisFamily<const D: usize>: Sync + Send {
         out: &mut PointSupport<D>,
     ) -> Result<(), BasisError>;
 
-    /// The box (lower, upper corner) whose overlap with each cell counts as the point's
-    /// material there for the ghost penalty's cell fill; `None`: all of it in the cell holding
-    /// the point.
-    fn fill_box(&self, point: &PointView<'_, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)>;
+    /// The box (lower, upper corner) whose overlap with each cell of `grid` counts as the
+    /// point's material there for the ghost penalty's cell fill; `None`: all of it in the cell
+    /// holding the point. Every node the point's weights reach must be a node of a cell the
+    /// box overlaps, or the ghost penalty cannot see it (see the B-spline kernel's
+    /// [`AxisKernel::fill_half_width`]).
+    fn fill_box(
+        &self,
+        grid: &Grid<D>,
+        point: &PointView<'_, D>,
+    ) -> Option<(SVector<f64, D>, SVector<f64, D>)>;
 
     /// Move tracked corners with a converged nodal increment (families that track them).
     fn update_corners(
@@ -359,13 +373,17 @@ impl<const D: usize, K: AxisKernel> BasisFamily<D> for TensorProduct<K> {
         Ok(())
     }
 
-    fn fill_box(&self, point: &PointView<'_, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
-        self.0.has_domain().then(|| {
-            (
-                point.position - point.half_length,
-                point.position + point.half_length,
-            )
-        })
+    fn fill_box(
+        &self,
+        grid: &Grid<D>,
+        point: &PointView<'_, D>,
+    ) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+        let h = grid.spacing();
+        let mut w = SVector::<f64, D>::zeros();
+        for a in 0..D {
+            w[a] = self.0.fill_half_width(h[a], point.half_length[a])?;
+        }
+        Some((point.position - w, point.position + w))
     }
 }
 

@@ -44,7 +44,11 @@ impl<const D: usize, B: BasisFamily<D>> BasisFamily<D> for TotalLagrangian<B> {
         Ok(())
     }
 
-    fn fill_box(&self, point: &PointView<'_, D>) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
-        self.0.fill_box(&point.reference())
+    fn fill_box(
+        &self,
+        grid: &Grid<D>,
+        point: &PointView<'_, D>,
+    ) -> Option<(SVector<f64, D>, SVector<f64, D>)> {
+        self.0.fill_box(grid, &point.reference())
     }
 }

@@ -361,6 +361,7 @@ fn main() -> ExitCode {
             path: cli.out.display().to_string(),
             message: e.to_string(),
         })
+        .and_then(|_| kinds::render_methods(&cli.out))
         .and_then(|_| kinds::render_index(&cli.out))
     {
         eprintln!("error: {e}");

@@ -99,6 +99,49 @@ pub fn report_markdown(results: &CantileverResults, not_drawn: &[super::NotDrawn
         }
         s.push('\n');
     }
+    for r in &study.refinement {
+        let reference = refinement_reference(results, r);
+        let _ = write!(
+            s,
+            "## {}\n\nEvery method on the beam's base case at each element size (h = {}); Δ = u/u_ref − 1 (v likewise) against {} at the same h; the last column against the reference's u/L ({}). {}{}\n\n| method | h | status | u/L | v/L | Δu | Δv | u/L over the reference |\n|---|---:|---|---:|---:|---:|---:|---:|\n",
+            r.title,
+            r.element_sizes.iter().map(|h| h.to_string()).collect::<Vec<_>>().join(", "),
+            r.reference.label(),
+            reference.as_ref().map_or("none".into(), |(u, what)| format!("{u:.6}: {what}")),
+            if r.element_sizes.len() > r.quick_element_sizes.as_ref().map_or(usize::MAX, |q| q.len())
+                && results.provenance.tier == crate::study::Tier::Quick
+            {
+                "The quick tier runs the coarser sizes only, so no GCI extrapolation is checked. "
+            } else {
+                ""
+            },
+            r.note
+        );
+        for x in results
+            .measures
+            .refinement
+            .iter()
+            .filter(|x| x.refinement == r.id)
+        {
+            let status = results.case(&x.case).map_or("not run", |c| c.status.word());
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} | {} | {} |",
+                x.method.label(),
+                x.element_size,
+                status,
+                f5(x.u_over_l),
+                f5(x.v_over_l),
+                pct(x.difference_u),
+                pct(x.difference_v),
+                match (x.u_over_l, &reference) {
+                    (Some(u), Some((r, _))) => format!("{:.4}", u / r),
+                    _ => "—".into(),
+                }
+            );
+        }
+        s.push('\n');
+    }
     s.push_str(&checks_markdown(&results.checks));
     // Load path every 5 steps (Figure 21's data).
     let shown: Vec<&CantileverRecord> = results
@@ -268,7 +311,71 @@ fn render_figure(
             };
             xy_svg(&f.title, &axes, &series).map(Some).map_err(fail)
         }
+        CantileverFigureKind::Refinement => {
+            let Some(r) = results
+                .study
+                .refinement
+                .iter()
+                .find(|r| Some(&r.id) == f.refinement.as_ref())
+            else {
+                return Ok(None);
+            };
+            let Some((u_ref, what)) = refinement_reference(results, r) else {
+                return Ok(None);
+            };
+            let series: Vec<XySeries> = r
+                .methods
+                .iter()
+                .map(|&m| XySeries {
+                    label: m.label().to_string(),
+                    points: results
+                        .measures
+                        .refinement
+                        .iter()
+                        .filter(|x| x.refinement == r.id && x.method == m)
+                        .filter_map(|x| Some((x.element_size, x.u_over_l? / u_ref)))
+                        .collect(),
+                    line: true,
+                    markers: true,
+                })
+                .filter(|s| !s.points.is_empty())
+                .collect();
+            let axes = XyAxes {
+                x_desc: "element size h".into(),
+                y_desc: "final u/L over the reference".into(),
+                log_x: true,
+                log_y: false,
+                y_lines: vec![(0.99, "−1 %".into()), (1.01, "+1 %".into())],
+                legend: LegendCorner::LowerLeft,
+            };
+            let title = format!("{} (reference: {what})", f.title);
+            xy_svg(&title, &axes, &series).map(Some).map_err(fail)
+        }
     }
+}
+
+/// The refinement's reference u/L: the reference method's GCI extrapolation in the asymptotic
+/// range, else its finest converged case; with what it is in words.
+fn refinement_reference(results: &CantileverResults, r: &RefinementSection) -> Option<(f64, String)> {
+    let gci = results
+        .measures
+        .gci
+        .iter()
+        .find(|g| g.sweep == r.id && g.series == r.reference.label() && g.measure == "final u/L");
+    if let Some(x) = gci
+        .and_then(|g| g.gci.as_ref())
+        .filter(|x| x.in_asymptotic_range())
+    {
+        return Some((x.extrapolated, format!("{}, extrapolated", r.reference.label())));
+    }
+    results
+        .measures
+        .refinement
+        .iter()
+        .filter(|x| x.refinement == r.id && x.method == r.reference)
+        .filter_map(|x| Some((x.element_size, x.u_over_l?)))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(h, u)| (u, format!("finest {}, h = {h}", r.reference.label())))
 }
 
 /// Render the report and figures from `dir`'s `results.json` and `domains.json`.

@@ -7,6 +7,7 @@ pub mod cantilever;
 pub mod column;
 pub mod compaction;
 pub mod manufactured;
+pub mod methods;
 
 use crate::study::checks::{check_counts, CheckRecord, GciRecord};
 use crate::study::results::{write_text, CaseRecordOf, CaseStatus, FailureRecord, Timing};

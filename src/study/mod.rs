@@ -17,6 +17,7 @@ pub mod column;
 pub mod compaction;
 pub mod engine;
 pub mod manufactured;
+pub mod methods;
 pub mod replace;
 pub mod results;
 pub mod store;

@@ -126,3 +126,28 @@ fn cantilever_quick_outputs_rerender_byte_identically_and_runs_repeat() {
     assert_eq!(again.results.without_timing(), quick().results.without_timing());
     assert_eq!(again.outputs, quick().outputs);
 }
+
+/// Every basis family refined with Q8 (`[[refinement]] families`, quick tier: 20 × 2 and
+/// 40 × 4 elements): every case converges and each family's checked band against Q8 at the
+/// same element size holds (bands and measurements in studies/cantilever.toml; the GCI
+/// extrapolations need the full tier's third size and are absent here).
+#[test]
+fn cantilever_every_family_refined_agrees_with_q8() {
+    let r = &quick().results;
+    let rows = &r.measures.refinement;
+    assert_eq!(rows.len(), 7 * 2, "{rows:#?}");
+    for row in rows {
+        let c = r.case(&row.case).unwrap();
+        assert_eq!(c.status, CaseStatus::Converged, "{}: {:?}", c.id, c.failure);
+    }
+    let checks: Vec<_> = r
+        .checks
+        .iter()
+        .filter(|c| c.id.starts_with("families-"))
+        .collect();
+    assert_eq!(checks.len(), 4, "{checks:#?}");
+    for c in checks {
+        assert_eq!(c.pass, Some(true), "{c:#?}");
+    }
+    assert!(!r.checks.iter().any(|c| c.id.contains("extrapolated")));
+}

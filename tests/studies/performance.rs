@@ -69,9 +69,14 @@ fn performance_fields_match_the_problem_size_and_add_up() {
                 }
                 m => {
                     assert!(m.uses_material_points(), "{}", c.id);
-                    // A point's GIMP support has at most 3 nodes per axis, so two nodes share a
-                    // point only within 2 nodes of each other: an equation couples with at
-                    // most 2 × 5 × 5 equations; every diagonal is stored.
+                    let Method::MaterialPoint(basis) = m else {
+                        unreachable!()
+                    };
+                    let k = basis.family::<2>().support_nodes();
+                    // A point's support has k nodes per axis (3 for GIMP, 4 for the cubic
+                    // spline), so two nodes share a point only within k − 1 nodes of each
+                    // other: an equation couples with at most 2 (2k − 1)² equations; every
+                    // diagonal is stored.
                     let nodes = ((w / c.h).round() as usize + 3) * ((ht / c.h).round() as usize + 3);
                     assert!(
                         s.unknowns > 0 && s.unknowns <= 2 * nodes,
@@ -80,7 +85,7 @@ fn performance_fields_match_the_problem_size_and_add_up() {
                         s.unknowns
                     );
                     assert!(
-                        s.nonzeros >= s.unknowns && s.nonzeros <= 50 * s.unknowns,
+                        s.nonzeros >= s.unknowns && s.nonzeros <= 2 * (2 * k - 1).pow(2) * s.unknowns,
                         "{}: nnz {} for {} unknowns",
                         c.id,
                         s.nonzeros,

@@ -141,10 +141,14 @@ impl StudyKind for CantileverStudy {
             elastica.extend(elastica_path(&base, false));
         }
         let depth_study = super::checks::depth_rows(study, &results.cases);
+        let refinement = super::checks::refinement_rows(study, &results.cases);
+        let mut gci = super::checks::gci_records(study, &depth_study);
+        gci.extend(super::checks::refinement_gci(study, &refinement));
         results.measures = CantileverMeasures {
             elastica,
-            gci: super::checks::gci_records(study, &depth_study),
+            gci,
             depth_study,
+            refinement,
         };
         results.checks = super::checks::compute_checks(results);
     }

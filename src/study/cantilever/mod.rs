@@ -100,6 +100,51 @@ pub struct DepthStudy {
     pub source: String,
 }
 
+/// A refinement: every method of `methods` at each element size (the beam's depth over an
+/// even number of elements), on the base case's domain and volume update; case ids
+/// `{id}-{method}-h{h}`. Sizes not in `quick_element_sizes` are full-tier only.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RefinementSection {
+    pub id: String,
+    pub title: String,
+    pub methods: Vec<Method>,
+    pub element_sizes: Vec<f64>,
+    /// The quick tier's element sizes (default: all of them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quick_element_sizes: Option<Vec<f64>>,
+    /// The method every other is compared with at the same element size, and whose GCI
+    /// extrapolation is the converged continuum.
+    pub reference: Method,
+    /// What the report says about the comparison (e.g. the reference's own singularities).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub note: String,
+}
+
+/// Every case of `methods` in `refinement` with h ≤ `max_element_size`: final u/L and v/L
+/// within `tolerance` (relative) of the reference method's at the same element size.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RefinedExpectation {
+    pub refinement: String,
+    pub methods: Vec<Method>,
+    pub max_element_size: f64,
+    pub tolerance: f64,
+    pub source: String,
+}
+
+/// The GCI extrapolation of `method`'s final u/L over the three finest element sizes of
+/// `refinement` within `tolerance` (relative) of the reference method's; evaluated only in a
+/// tier that runs three sizes (the check is absent otherwise, and the report says so).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExtrapolatedExpectation {
+    pub refinement: String,
+    pub method: Method,
+    pub tolerance: f64,
+    pub source: String,
+}
+
 /// Final u/L and v/L of `case` within `tolerance` (relative) of the elastica.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -146,6 +191,9 @@ pub enum CantileverFigureKind {
     Domains,
     /// u/L and v/L against load for several cases and the elastica (Figure 21).
     EndDisplacement,
+    /// Final u/L over the reference's GCI extrapolation against h, every method of a
+    /// refinement (`refinement`).
+    Refinement,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -161,6 +209,9 @@ pub struct CantileverFigure {
     /// Domain figures: mark the loaded points.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub mark_loads: bool,
+    /// Refinement figures: the refinement drawn.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<String>,
 }
 
 /// `studies/cantilever.toml`.
@@ -183,6 +234,12 @@ pub struct CantileverStudy {
     pub cases: Vec<CaseSection>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub depth_study: Option<DepthStudy>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub refinement: Vec<RefinementSection>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expect_refined: Vec<RefinedExpectation>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expect_extrapolated: Vec<ExtrapolatedExpectation>,
     #[serde(default)]
     pub expect_completes: Vec<CompletionExpectation>,
     #[serde(default)]
@@ -208,4 +265,5 @@ pub struct CantileverCase {
 pub use crate::problems::cantilever::DomainSnapshot;
 pub use records::{
     CantileverMeasures, CantileverRecord, CantileverResults, DepthRow, ElasticaPath, ElasticaPoint,
+    RefinementRow,
 };

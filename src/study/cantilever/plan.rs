@@ -89,6 +89,92 @@ impl CantileverStudy {
                 ));
             }
         }
+        let mut refinement_ids = BTreeSet::new();
+        for (i, r) in self.refinement.iter().enumerate() {
+            chk.unique_ident(&format!("refinement[{i}].id"), &r.id, &mut refinement_ids)?;
+            if r.methods.is_empty() {
+                return Err(chk.err(
+                    format!("refinement[{i}].methods"),
+                    "[]",
+                    "must list at least one method",
+                ));
+            }
+            for m in r.methods.iter().chain([&r.reference]) {
+                m.expect_one_of("the cantilever", methods(dimension))
+                    .map_err(|e| chk.err(format!("refinement[{i}].methods"), m.name(), e.allowed))?;
+            }
+            if !r.methods.contains(&r.reference) {
+                return Err(chk.err(
+                    format!("refinement[{i}].reference"),
+                    r.reference.name(),
+                    "must be one of the refinement's methods",
+                ));
+            }
+            if r.element_sizes.is_empty() {
+                return Err(chk.err(
+                    format!("refinement[{i}].element_sizes"),
+                    "[]",
+                    "must list at least one size",
+                ));
+            }
+            for &h in &r.element_sizes {
+                chk.positive(&format!("refinement[{i}].element_sizes"), h)?;
+            }
+            for &h in r.quick_element_sizes.iter().flatten() {
+                if !r.element_sizes.contains(&h) {
+                    return Err(chk.err(
+                        format!("refinement[{i}].quick_element_sizes"),
+                        h,
+                        "must be among the refinement's element_sizes",
+                    ));
+                }
+            }
+        }
+        for (c, _) in self.refinement_cases() {
+            if self.cases.iter().any(|x| x.id == c.id) {
+                return Err(chk.err(
+                    "refinement",
+                    &c.id,
+                    "a refinement's case id `{refinement}-{method}-h{h}` must not repeat a [[cases]] id",
+                ));
+            }
+        }
+        let refinement_known = |key: String, id: &str| -> Result<&super::RefinementSection, StudyError> {
+            self.refinement
+                .iter()
+                .find(|r| r.id == id)
+                .ok_or_else(|| chk.err(key, id, "must name a refinement"))
+        };
+        for (i, e) in self.expect_refined.iter().enumerate() {
+            let r = refinement_known(format!("expect_refined[{i}].refinement"), &e.refinement)?;
+            for m in &e.methods {
+                if !r.methods.contains(m) || *m == r.reference {
+                    return Err(chk.err(
+                        format!("expect_refined[{i}].methods"),
+                        m.name(),
+                        format!(
+                            "must name methods of refinement {:?} other than its reference",
+                            r.id
+                        ),
+                    ));
+                }
+            }
+            chk.positive(&format!("expect_refined[{i}].tolerance"), e.tolerance)?;
+        }
+        for (i, e) in self.expect_extrapolated.iter().enumerate() {
+            let r = refinement_known(format!("expect_extrapolated[{i}].refinement"), &e.refinement)?;
+            if !r.methods.contains(&e.method) || e.method == r.reference {
+                return Err(chk.err(
+                    format!("expect_extrapolated[{i}].method"),
+                    e.method.name(),
+                    format!(
+                        "must name a method of refinement {:?} other than its reference",
+                        r.id
+                    ),
+                ));
+            }
+            chk.positive(&format!("expect_extrapolated[{i}].tolerance"), e.tolerance)?;
+        }
         for (i, e) in self.expect_completes.iter().enumerate() {
             known(format!("expect_completes[{i}].case"), &e.case)?;
         }
@@ -121,6 +207,26 @@ impl CantileverStudy {
             chk.unique_ident(&format!("figures[{i}].id"), &f.id, &mut fig_ids)?;
             for c in &f.cases {
                 known(format!("figures[{i}].cases"), c)?;
+            }
+            match (&f.refinement, f.kind == CantileverFigureKind::Refinement) {
+                (Some(r), true) => {
+                    refinement_known(format!("figures[{i}].refinement"), r)?;
+                }
+                (None, true) => {
+                    return Err(chk.err(
+                        format!("figures[{i}].refinement"),
+                        "absent",
+                        "a refinement figure must name its refinement",
+                    ))
+                }
+                (Some(r), false) => {
+                    return Err(chk.err(
+                        format!("figures[{i}].refinement"),
+                        r,
+                        "only a figure of kind \"refinement\" draws a refinement",
+                    ))
+                }
+                (None, false) => {}
             }
             if f.kind == CantileverFigureKind::Domains && f.cases.len() != 1 {
                 return Err(chk.err(
@@ -226,6 +332,7 @@ impl CantileverStudy {
             .iter()
             .map(|c| (self.case_of(c), c.full_only))
             .collect();
+        let refined: Vec<(CantileverCase, bool)> = self.refinement_cases();
         if let Some(d) = &self.depth_study {
             if let Some((base, full_only)) = out.iter().find(|(c, _)| c.id == d.case).cloned() {
                 for &n in &d.elements_through_depth {
@@ -233,6 +340,39 @@ impl CantileverStudy {
                     for &depth in own.iter().chain(&d.depths) {
                         out.push((self.depth_case(&base, depth, n), full_only || d.full_only));
                     }
+                }
+            }
+        }
+        out.extend(refined);
+        out
+    }
+
+    /// The id of `method`'s case at element size `h` in refinement `id`.
+    pub fn refinement_case_id(id: &str, method: crate::method::Method, h: f64) -> String {
+        format!("{id}-{}-h{h}", method.name())
+    }
+
+    /// The refinements' cases (with their full-only flags): every method at every size on the
+    /// beam's base case (domain and volume update, ghost and weak-node defaults).
+    fn refinement_cases(&self) -> Vec<(CantileverCase, bool)> {
+        let base = self.base_spec();
+        let mut out = vec![];
+        for r in &self.refinement {
+            for &m in &r.methods {
+                for &h in &r.element_sizes {
+                    let quick = r.quick_element_sizes.as_ref().is_none_or(|q| q.contains(&h));
+                    out.push((
+                        CantileverCase {
+                            id: Self::refinement_case_id(&r.id, m, h),
+                            method: m,
+                            spec: CantileverSpec {
+                                element_size: h,
+                                ..base
+                            },
+                            snapshot_every: 0,
+                        },
+                        !quick,
+                    ));
                 }
             }
         }

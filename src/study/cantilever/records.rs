@@ -73,15 +73,34 @@ pub struct DepthRow {
     pub difference_v: Option<f64>,
 }
 
+/// One case of a refinement against the reference method at the same element size.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RefinementRow {
+    pub refinement: String,
+    pub case: String,
+    pub method: Method,
+    pub element_size: f64,
+    pub u_over_l: Option<f64>,
+    pub v_over_l: Option<f64>,
+    /// u/u_ref − 1 and v/v_ref − 1 against the reference method's case at the same element
+    /// size (positive: a longer displacement than the reference's).
+    pub difference_u: Option<f64>,
+    pub difference_v: Option<f64>,
+}
+
 /// The cantilever's measures in `results.json`: the elastica and the depth study.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct CantileverMeasures {
     /// Plane strain first, then plane stress when asked for.
     pub elastica: Vec<ElasticaPath>,
     pub depth_study: Vec<DepthRow>,
-    /// Grid convergence index of the end displacement at each depth of the depth study.
+    /// Grid convergence index of the end displacement at each depth of the depth study, then
+    /// of every method of every refinement.
     #[serde(default)]
     pub gci: Vec<crate::study::checks::GciRecord>,
+    /// Every refinement case against its reference at the same element size.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub refinement: Vec<RefinementRow>,
 }
 
 /// `results.json` of the cantilever study.

@@ -104,6 +104,9 @@ pub struct CompactionSweep {
 #[serde(deny_unknown_fields)]
 pub struct GhostSpreadExpectation {
     pub sweep: String,
+    /// The material point methods checked, each on its own (default: iGIMP only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub methods: Vec<Method>,
     pub max_element_size: f64,
     pub tolerance: f64,
     pub source: String,
@@ -139,7 +142,23 @@ pub struct ReferenceSection {
 #[serde(deny_unknown_fields)]
 pub struct DeviationExpectation {
     pub sweep: String,
+    /// The material point methods checked (default: iGIMP only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub methods: Vec<Method>,
     pub max_element_size: f64,
+    pub tolerance: f64,
+    pub source: String,
+}
+
+/// The GCI extrapolation (Celik et al. 2008) of one method's series in `sweep` (the study's
+/// default treatment, the three finest element sizes) lies within `tolerance` (relative) of
+/// the Figure 17 reference, and the series is in the asymptotic range; a series outside it
+/// fails the check.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExtrapolationExpectation {
+    pub sweep: String,
+    pub method: Method,
     pub tolerance: f64,
     pub source: String,
 }
@@ -150,6 +169,9 @@ pub struct DeviationExpectation {
 #[serde(deny_unknown_fields)]
 pub struct ConvergenceExpectation {
     pub sweep: String,
+    /// The material point methods checked, each series on its own (default: iGIMP only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub methods: Vec<Method>,
     pub slack: f64,
     pub source: String,
 }
@@ -229,6 +251,8 @@ pub struct CompactionStudy {
     pub reference: ReferenceSection,
     #[serde(default)]
     pub expect_deviation: Vec<DeviationExpectation>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expect_extrapolation: Vec<ExtrapolationExpectation>,
     #[serde(default)]
     pub expect_convergence: Vec<ConvergenceExpectation>,
     #[serde(default)]

@@ -100,7 +100,33 @@ impl CompactionStudy {
         sweep_known("reference.fem_sweep".into(), &self.reference.fem_sweep)?;
         sweep_known("reference.igimp_sweep".into(), &self.reference.igimp_sweep)?;
         for (i, e) in self.expect_deviation.iter().enumerate() {
-            sweep_known(format!("expect_deviation[{i}].sweep"), &e.sweep)?;
+            let sweep = sweep_known(format!("expect_deviation[{i}].sweep"), &e.sweep)?;
+            for m in &e.methods {
+                if m.is_fem() || !sweep.methods.contains(m) {
+                    return Err(chk.err(
+                        format!("expect_deviation[{i}].methods"),
+                        m.name(),
+                        format!("must name material point methods of sweep {:?}", e.sweep),
+                    ));
+                }
+            }
+        }
+        for (i, e) in self.expect_extrapolation.iter().enumerate() {
+            let sweep = sweep_known(format!("expect_extrapolation[{i}].sweep"), &e.sweep)?;
+            if !sweep.methods.contains(&e.method) {
+                return Err(chk.err(
+                    format!("expect_extrapolation[{i}].method"),
+                    e.method.name(),
+                    format!("must be a method of sweep {:?}", e.sweep),
+                ));
+            }
+            if !(e.tolerance > 0.0 && e.tolerance < 1.0) {
+                return Err(chk.err(
+                    format!("expect_extrapolation[{i}].tolerance"),
+                    e.tolerance,
+                    "must lie in (0, 1) (relative)",
+                ));
+            }
         }
         for (i, e) in self.expect_ghost_spread.iter().enumerate() {
             sweep_known(format!("expect_ghost_spread[{i}].sweep"), &e.sweep)?;

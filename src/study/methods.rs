@@ -1,0 +1,504 @@
+//! The cross-method comparison: every method's fitted rates, deviations and GCI
+//! extrapolations, gathered from the `results.json` of the studies in one output folder into
+//! `<out>/methods/methods.json`, which `crate::render::methods` alone draws from.
+//!
+//! Nothing is solved here. The column-type and manufactured studies contribute their fitted
+//! rates (the `rates` array) and, for the overlay figures, each rate's errors against its
+//! resolution (the cases of its sweep); the compaction and cantilever studies contribute every
+//! method's end value against the study's reference at each element size and its GCI
+//! extrapolation. A series is one method in one group: the study, the measure and the keys
+//! that must agree for two methods to share axes (load, points per cell, field, domain
+//! update).
+
+use crate::method::Method;
+use crate::study::results::Software;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::collections::BTreeMap;
+
+/// `<out>/methods/methods.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MethodsResults {
+    pub software: Software,
+    /// Each study read: name, tier and its results' software line.
+    pub sources: Vec<Source>,
+    /// Fitted log-log slopes.
+    pub rates: Vec<RateRow>,
+    /// End values against a reference (compaction, cantilever).
+    pub references: Vec<ReferenceRow>,
+    /// Overlay figures: one per group with at least [`MIN_METHODS_PER_FIGURE`] methods.
+    pub groups: Vec<Group>,
+}
+
+/// Groups with fewer methods are tabulated but not drawn (their own study's report draws
+/// them).
+pub const MIN_METHODS_PER_FIGURE: usize = 3;
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Source {
+    pub study: String,
+    pub tier: String,
+    pub software: String,
+}
+
+/// One fitted rate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RateRow {
+    pub study: String,
+    /// The group's keys in words (e.g. "W = 40000, 2 points per cell").
+    pub group: String,
+    pub measure: String,
+    pub sweep: String,
+    pub method: Method,
+    pub slope: Option<f64>,
+    /// The resolutions fitted (elements or cells per side).
+    pub levels: Vec<f64>,
+    /// The study's asserted band (rate ± tolerance), if any, and whether it held.
+    pub expected: Option<(f64, f64)>,
+    pub pass: Option<bool>,
+}
+
+/// One method's end value against the study's reference: at each element size and, where the
+/// three finest are in the asymptotic range, the GCI extrapolation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceRow {
+    pub study: String,
+    pub sweep: String,
+    pub measure: String,
+    pub method: Method,
+    /// What the values are divided by, in words.
+    pub reference: String,
+    /// (h, value / reference) of each converged case.
+    pub ratios: Vec<(f64, f64)>,
+    pub extrapolated_ratio: Option<f64>,
+    pub observed_order: Option<f64>,
+    pub gci_note: String,
+}
+
+/// An overlay: one series per method, on the same axes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Group {
+    pub id: String,
+    pub title: String,
+    pub x_desc: String,
+    pub y_desc: String,
+    pub log_y: bool,
+    pub series: Vec<(Method, Vec<(f64, f64)>)>,
+}
+
+fn f(v: &Value) -> Option<f64> {
+    v.as_f64()
+}
+
+fn method_of(v: &Value) -> Option<Method> {
+    serde_json::from_value(v.clone()).ok()
+}
+
+fn number(x: f64) -> String {
+    crate::study::vocabulary::number(x)
+}
+
+/// The error field of a rate's measure in a case record.
+fn case_field(measure: &str) -> &str {
+    match measure {
+        "displacement" => "displacement_error",
+        "stress" => "stress_error",
+        m => m,
+    }
+}
+
+/// Gather every study's results of `studies` (name, parsed `results.json`), in order.
+pub fn collect(studies: &[(String, Value)]) -> MethodsResults {
+    let mut out = MethodsResults {
+        software: Software::this_build(),
+        sources: vec![],
+        rates: vec![],
+        references: vec![],
+        groups: vec![],
+    };
+    for (name, r) in studies {
+        out.sources.push(Source {
+            study: name.clone(),
+            tier: r["tier"].as_str().unwrap_or("?").to_string(),
+            software: serde_json::from_value::<Software>(r["software"].clone())
+                .map_or("?".into(), |s| s.label()),
+        });
+        let problem = r["study"]["problem"].as_str().unwrap_or("");
+        match problem {
+            "compaction" => compaction(name, r, &mut out),
+            "cantilever" => cantilever(name, r, &mut out),
+            _ if r["rates"].is_array() => rates(name, r, &mut out),
+            _ => {}
+        }
+    }
+    out
+}
+
+/// Column-type and manufactured studies: their fitted rates and the errors behind them.
+fn rates(name: &str, r: &Value, out: &mut MethodsResults) {
+    let cases: BTreeMap<&str, &Value> = r["cases"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|c| Some((c["id"].as_str()?, c)))
+        .collect();
+    let manufactured = r["study"]["problem"].as_str() == Some("manufactured");
+    let mut groups: BTreeMap<(String, String), Group> = BTreeMap::new();
+    for rate in r["rates"].as_array().into_iter().flatten() {
+        let (Some(sweep), Some(method), Some(measure)) = (
+            rate["sweep"].as_str(),
+            method_of(&rate["method"]),
+            rate["measure"].as_str(),
+        ) else {
+            continue;
+        };
+        let ppc = rate["points_per_cell"].as_i64();
+        let domain_update = rate["domain_update"].as_str();
+        let level_key = if manufactured { "cells" } else { "elements" };
+        let levels: Vec<f64> = rate[if manufactured {
+            "cells_used"
+        } else {
+            "elements_used"
+        }]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(f)
+        .collect();
+        // The sweep's cases of this series, for the overlay.
+        let ids: Vec<&str> = r["sweep_cases"][sweep]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|v| v.as_str())
+            .collect();
+        let series_cases: Vec<&Value> = ids
+            .iter()
+            .filter_map(|id| cases.get(id).copied())
+            .filter(|c| method_of(&c["method"]) == Some(method))
+            .filter(|c| c["points_per_cell"].as_i64() == ppc || method.is_fem())
+            .filter(|c| rate["load"].is_null() || c["load"] == rate["load"])
+            .filter(|c| domain_update.is_none() || c["domain_update"].as_str() == domain_update)
+            .collect();
+        let field = series_cases
+            .first()
+            .and_then(|c| c["field"].as_str())
+            .map(str::to_string);
+        let mut keys = vec![];
+        if let Some(fl) = &field {
+            keys.push(format!("{fl} field"));
+        }
+        if let Some(w) = f(&rate["load"]) {
+            keys.push(format!("W = {}", number(w)));
+        }
+        if let (Some(p), false) = (ppc, method.is_fem()) {
+            keys.push(format!("{p} points per cell (per axis)"));
+        }
+        if let Some(d) = domain_update.filter(|d| *d != "stretch") {
+            keys.push(format!("{d} domain update"));
+        }
+        let group = keys.join(", ");
+        let expected = rate["expected"]
+            .is_object()
+            .then(|| Some((f(&rate["expected"]["rate"])?, f(&rate["expected"]["tolerance"])?)))
+            .flatten();
+        out.rates.push(RateRow {
+            study: name.to_string(),
+            group: group.clone(),
+            measure: measure.to_string(),
+            sweep: sweep.to_string(),
+            method,
+            slope: f(&rate["slope"]),
+            levels: levels.clone(),
+            expected,
+            pass: rate["pass"].as_bool(),
+        });
+        // FEM series have no points per cell: they join the material point groups of the
+        // same field and load only through their own group, so they are not overlaid.
+        if method.is_fem() {
+            continue;
+        }
+        let points: Vec<(f64, f64)> = series_cases
+            .iter()
+            .filter_map(|c| Some((f(&c[level_key])?, f(&c[case_field(measure)])?)))
+            .filter(|&(_, e)| e > 0.0)
+            .collect();
+        if points.is_empty() {
+            continue;
+        }
+        let g = groups
+            .entry((measure.to_string(), group.clone()))
+            .or_insert_with(|| Group {
+                id: format!("{name}-{measure}-{}", groups_slug(&group)),
+                title: format!("{name}: {measure} against {level_key}, {group}"),
+                x_desc: level_key.to_string(),
+                y_desc: format!("{measure} error"),
+                log_y: true,
+                series: vec![],
+            });
+        // One series per method: the first sweep that fits it (the families sweeps repeat
+        // nothing, the paper's sweeps come first).
+        if !g.series.iter().any(|(m, _)| *m == method) {
+            g.series.push((method, points));
+        }
+    }
+    out.groups.extend(
+        groups
+            .into_values()
+            .filter(|g| g.series.len() >= MIN_METHODS_PER_FIGURE),
+    );
+}
+
+/// A file-name slug of a group's words.
+fn groups_slug(words: &str) -> String {
+    let mut s: String = words
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '-'
+            }
+        })
+        .collect();
+    while s.contains("--") {
+        s = s.replace("--", "-");
+    }
+    s.trim_matches('-').to_string()
+}
+
+/// A GCI record's (extrapolated value, order, note) for `series` of `sweep`, if any.
+fn gci_of(r: &Value, sweep: &str, series: &str, measure: &str) -> (Option<f64>, Option<f64>, String) {
+    let rec = r["gci"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .find(|g| g["sweep"] == sweep && g["series"] == series && g["measure"] == measure);
+    match rec {
+        Some(g) => {
+            let asym = g["note"].as_str() == Some("in the asymptotic range");
+            (
+                f(&g["gci"]["extrapolated"]).filter(|_| asym),
+                f(&g["gci"]["order"]),
+                g["note"].as_str().unwrap_or("").to_string(),
+            )
+        }
+        None => (None, None, "no GCI".into()),
+    }
+}
+
+/// The compaction: every sweep with two or more material point methods, Figure 17's measure
+/// over the study's reference.
+fn compaction(name: &str, r: &Value, out: &mut MethodsResults) {
+    let Some(reference) = f(&r["reference"]["value"]) else {
+        return;
+    };
+    let what = r["reference"]["description"].as_str().unwrap_or("").to_string();
+    let dim = r["study"]["block"]["dimension"].as_i64().unwrap_or(2);
+    for sw in r["study"]["sweeps"].as_array().into_iter().flatten() {
+        let Some(id) = sw["id"].as_str() else { continue };
+        let methods: Vec<Method> = sw["methods"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(method_of)
+            .filter(|m| !m.is_fem())
+            .collect();
+        if methods.len() < 2 || !sw["ghost_gammas"].is_null() || !sw["yield_stress"].is_null() {
+            continue;
+        }
+        let ids: Vec<&str> = r["sweep_cases"][id]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(|v| v.as_str())
+            .collect();
+        let mut group = Group {
+            id: format!("{name}-{id}"),
+            title: format!("{name}, sweep {id}: max horizontal displacement over the reference against h"),
+            x_desc: "element size h".into(),
+            y_desc: "u_max / u_ref".into(),
+            log_y: false,
+            series: vec![],
+        };
+        for m in methods {
+            let cs: Vec<&Value> = r["cases"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter(|c| ids.contains(&c["id"].as_str().unwrap_or("")))
+                .filter(|c| method_of(&c["method"]) == Some(m))
+                .collect();
+            let Some(ppc) = cs.first().and_then(|c| c["points_per_cell"].as_i64()) else {
+                continue;
+            };
+            let ratios: Vec<(f64, f64)> = cs
+                .iter()
+                .filter(|c| c["points_per_cell"].as_i64() == Some(ppc))
+                .filter_map(|c| Some((f(&c["h"])?, f(&c["max_horizontal_displacement"])? / reference)))
+                .collect();
+            let grid = if dim == 3 {
+                format!("{ppc}×{ppc}×{ppc}")
+            } else {
+                format!("{ppc}×{ppc}")
+            };
+            let series = format!("{}, {grid} points", m.label());
+            let (ext, order, note) = gci_of(r, id, &series, "max horizontal displacement");
+            out.references.push(ReferenceRow {
+                study: name.to_string(),
+                sweep: id.to_string(),
+                measure: "max horizontal displacement".into(),
+                method: m,
+                reference: what.clone(),
+                ratios: ratios.clone(),
+                extrapolated_ratio: ext.map(|e| e / reference),
+                observed_order: order,
+                gci_note: note,
+            });
+            group.series.push((m, ratios));
+        }
+        if group.series.len() >= MIN_METHODS_PER_FIGURE {
+            out.groups.push(group);
+        }
+    }
+}
+
+/// The cantilever: every refinement's final u/L over its reference method's extrapolation.
+fn cantilever(name: &str, r: &Value, out: &mut MethodsResults) {
+    for refinement in r["study"]["refinement"].as_array().into_iter().flatten() {
+        let (Some(id), Some(reference)) = (refinement["id"].as_str(), method_of(&refinement["reference"]))
+        else {
+            continue;
+        };
+        let rows: Vec<&Value> = r["refinement"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter(|x| x["refinement"] == id)
+            .collect();
+        let (ext, _, _) = gci_of(r, id, reference.label(), "final u/L");
+        let finest = rows
+            .iter()
+            .filter(|x| method_of(&x["method"]) == Some(reference))
+            .filter_map(|x| Some((f(&x["element_size"])?, f(&x["u_over_l"])?)))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let (u_ref, what) = match (ext, finest) {
+            (Some(e), _) => (e, format!("{} u/L extrapolated (GCI)", reference.label())),
+            (None, Some((h, u))) => (u, format!("finest {} u/L, h = {h}", reference.label())),
+            _ => continue,
+        };
+        let mut group = Group {
+            id: format!("{name}-{id}"),
+            title: format!("{name}, refinement {id}: final u/L over the reference against h"),
+            x_desc: "element size h".into(),
+            y_desc: "u/L over the reference".into(),
+            log_y: false,
+            series: vec![],
+        };
+        for m in refinement["methods"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(method_of)
+        {
+            let ratios: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|x| method_of(&x["method"]) == Some(m))
+                .filter_map(|x| Some((f(&x["element_size"])?, f(&x["u_over_l"])? / u_ref)))
+                .collect();
+            let (e, order, note) = gci_of(r, id, m.label(), "final u/L");
+            out.references.push(ReferenceRow {
+                study: name.to_string(),
+                sweep: id.to_string(),
+                measure: "final u/L".into(),
+                method: m,
+                reference: what.clone(),
+                ratios: ratios.clone(),
+                extrapolated_ratio: e.map(|e| e / u_ref),
+                observed_order: order,
+                gci_note: note,
+            });
+            group.series.push((m, ratios));
+        }
+        if group.series.len() >= MIN_METHODS_PER_FIGURE {
+            out.groups.push(group);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    /// A column-type results file with three methods in one group and one FEM series: one
+    /// rate row each, one overlay of the three material point methods, errors from the cases.
+    #[test]
+    fn rates_are_gathered_per_group_and_overlaid() {
+        let case = |m: &str, e: i64, err: f64| {
+            json!({"id": format!("{m}-e{e}"), "method": m, "load": 4.0e4, "elements": e,
+                   "points_per_cell": 2, "stress_error": err})
+        };
+        let mut cases = vec![];
+        let mut rates = vec![];
+        let mut sweep = vec![];
+        for (m, p) in [
+            ("igimp", 2.0),
+            ("cpdi", 2.0),
+            ("bspline2", 0.0),
+            ("fem-linear", 1.0),
+        ] {
+            for e in [8, 16] {
+                cases.push(case(m, e, 1.0 / (e as f64).powf(p).max(1.0)));
+                sweep.push(format!("{m}-e{e}"));
+            }
+            rates.push(
+                json!({"sweep": "s", "method": m, "load": 4.0e4, "points_per_cell": 2,
+                              "measure": "stress_error", "slope": p, "elements_used": [8, 16],
+                              "expected": {"rate": p, "tolerance": 0.1}, "pass": true}),
+            );
+        }
+        let r = json!({"tier": "quick", "software": {"name": "igimp", "version": "0"},
+                       "study": {"problem": "column"}, "cases": cases, "rates": rates,
+                       "sweep_cases": {"s": sweep}});
+        let out = collect(&[("column".into(), r)]);
+        assert_eq!(out.rates.len(), 4);
+        assert_eq!(out.rates[0].expected, Some((2.0, 0.1)));
+        assert_eq!(out.groups.len(), 1, "{:#?}", out.groups);
+        let g = &out.groups[0];
+        assert_eq!(g.series.len(), 3);
+        assert_eq!(g.series[0].1, vec![(8.0, 1.0 / 64.0), (16.0, 1.0 / 256.0)]);
+        assert!(g.series.iter().all(|(m, _)| !m.is_fem()));
+    }
+
+    /// A compaction with a reference and a GCI record: ratios per h and the extrapolated ratio
+    /// only in the asymptotic range.
+    #[test]
+    fn compaction_deviations_and_extrapolations_are_gathered() {
+        let case = |m: &str, h: f64, u: f64| {
+            json!({"id": format!("{m}-h{h}"), "method": m, "h": h, "points_per_cell": 2,
+                   "max_horizontal_displacement": u})
+        };
+        let cases = vec![
+            case("igimp", 1.0, 0.99),
+            case("igimp", 0.5, 1.0),
+            case("mpm", 1.0, 1.1),
+        ];
+        let r = json!({"tier": "full", "software": {"name": "igimp", "version": "0"},
+            "study": {"problem": "compaction", "block": {"dimension": 2},
+                      "sweeps": [{"id": "f", "methods": ["igimp", "mpm"]}]},
+            "reference": {"value": 2.0, "description": "Q4"},
+            "sweep_cases": {"f": ["igimp-h1", "igimp-h0.5", "mpm-h1"]}, "cases": cases,
+            "gci": [{"sweep": "f", "series": "iGIMP, 2×2 points", "measure": "max horizontal displacement",
+                     "gci": {"extrapolated": 1.01, "order": 2.0}, "note": "in the asymptotic range"},
+                    {"sweep": "f", "series": "MPM, 2×2 points", "measure": "max horizontal displacement",
+                     "gci": {"extrapolated": 1.5, "order": 0.3}, "note": "oscillatory convergence"}]});
+        let out = collect(&[("compaction".into(), r)]);
+        assert_eq!(out.references.len(), 2);
+        let ig = &out.references[0];
+        assert_eq!(ig.ratios, vec![(1.0, 0.495), (0.5, 0.5)]);
+        assert_eq!(ig.extrapolated_ratio, Some(0.505));
+        assert_eq!(out.references[1].extrapolated_ratio, None);
+        assert!(out.groups.is_empty(), "two methods are not overlaid");
+    }
+}
