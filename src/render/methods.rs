@@ -45,11 +45,7 @@ fn rate_cell(rows: &[&RateRow]) -> String {
             cells.push(c);
         }
     }
-    if cells.is_empty() {
-        "".into()
-    } else {
-        cells.join(" / ")
-    }
+    cells.join(" / ")
 }
 
 fn report(r: &MethodsResults, drawn: &[(String, String)]) -> String {

@@ -12,6 +12,7 @@
 
 use crate::method::Method;
 use crate::study::results::Software;
+use crate::study::vocabulary::number;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -92,10 +93,6 @@ fn f(v: &Value) -> Option<f64> {
 
 fn method_of(v: &Value) -> Option<Method> {
     serde_json::from_value(v.clone()).ok()
-}
-
-fn number(x: f64) -> String {
-    crate::study::vocabulary::number(x)
 }
 
 /// The error field of a rate's measure in a case record.
