@@ -7,7 +7,9 @@ cd "$(dirname "$0")/.."
 if ! command -v slurmctld >/dev/null; then
     export DEBIAN_FRONTEND=noninteractive
     apt-get update -q >/dev/null
-    apt-get install -y -q slurm-wlm munge >/dev/null
+    # Without the recommended packages: 61 packages to resolve instead of 211 (apt-cache
+    # depends --recurse, 2026-12-03); slurmd/slurmctld need none of them here.
+    apt-get install -y -q --no-install-recommends slurm-wlm munge >/dev/null
 fi
 host="$(hostname -s)"
 cpus="$(nproc)"

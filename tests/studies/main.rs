@@ -12,4 +12,5 @@ mod performance;
 mod reliability;
 mod study;
 mod three_d_studies;
+mod trimmed;
 mod usability;

@@ -62,6 +62,10 @@ fn compaction_3d_quick_tier_converges_quadratically_and_passes_its_checks() {
         PLASTIC,
     );
     for c in &r.checks {
+        if c.id == "fig17-within-1pc-h0.5" {
+            assert_eq!(c.pass, None, "no iGIMP case at h = 1/2 in the quick tier");
+            continue;
+        }
         assert_eq!(
             c.pass,
             Some(true),
@@ -71,20 +75,23 @@ fn compaction_3d_quick_tier_converges_quadratically_and_passes_its_checks() {
             c.measured
         );
     }
-    // The quick tier has the reference's three Hex8 meshes: the full tier's extrapolation,
-    // 0.454910 (reports/compaction-3d, 2026-12-01), to round-off.
+    // The quick tier's reference is its finest Hex8 mesh, h = 1/2: the full tier's case,
+    // 0.449451 (reports/compaction-3d, 2026-12-01), to the printed digits.
     let reference = r.measures.reference.as_ref().expect("a reference");
     assert_eq!(reference.method, Method::FEM_HEX8);
     assert!(
-        (reference.value / 0.454910 - 1.0).abs() < 1e-6,
+        (reference.value / 0.449451 - 1.0).abs() < 2e-6,
         "{}",
         reference.value
     );
-    // 2x2x2 points per cell at h = 1: 0.45 % below it (full tier 0.9957).
+    // 2x2x2 points per cell at h = 1: 0.78 % above it (the full tier's 0.452943, 0.43 %
+    // below the extrapolated reference).
     let p2 = r
         .igimp_case("ghost", 1.0, 2)
         .expect("the h = 1, 2x2x2 case (default gamma)");
-    let dev = p2.max_horizontal_displacement.unwrap() / reference.value - 1.0;
+    let u = p2.max_horizontal_displacement.unwrap();
+    assert!((u / 0.452943 - 1.0).abs() < 2e-6, "{u}");
+    let dev = u / reference.value - 1.0;
     assert!(dev.abs() < 0.01, "{dev:e}");
     // The sizes are the 3D ones: 4 x 4 x 8 cells with 8 points each, 128 Hex8 elements.
     assert_eq!(p2.points, 1024);
@@ -114,12 +121,12 @@ fn cantilever_3d_quick_tier_completes_beside_the_elastica_and_hex20() {
             .map(|c| (c.id.as_str(), c.status, &c.steps[..])),
         (1e-4, 1e-8, 100.0),
     );
-    // The ghost sensitivity at h = 0.5 exceeds the 2D band in 3D (0.51 % with cut_share,
-    // reference/README.md items 29 and 38): shown, not required; the study checks it at
-    // h = 0.25 in the full tier (0.17 %).
-    let u = |id: &str| r.case(id).unwrap().u_over_l.unwrap();
-    let spread = ((u("stretch-g0.001") - u("stretch-g0.1")) / u("stretch-g0.1")).abs();
-    assert!(spread > 2e-3 && spread < 1e-2, "{spread:e}");
+    // The ghost sensitivity (full tier only: 0.51 % at h = 0.5, shown; 0.17 % at h = 0.25,
+    // checked; reference/README.md items 29 and 38).
+    assert!(
+        r.case("stretch-g0.1").is_none(),
+        "a full-tier case in the quick tier"
+    );
     for c in &r.checks {
         if c.id == "stretch-h0.25-g0.001-vs-stretch-h0.25-g0.1" {
             assert_eq!(c.pass, None, "full-tier cases: not evaluated in the quick tier");

@@ -1,0 +1,38 @@
+//! Study files cut to a few of their sweeps, for tests whose subject is the harness (resume,
+//! timing fields, determinism) rather than the study's numbers: every sweep not kept is
+//! dropped with each table that names it (`sweep = ...` or `refinement = ...`), so the cut
+//! file loads and runs like the original on fewer cases.
+
+use std::path::{Path, PathBuf};
+
+/// `studies/<name>.toml` without the sweeps and refinements whose ids are in `drop`, written
+/// into `dir` (returned, for `--studies-dir`).
+pub fn write(dir: &Path, name: &str, drop: &[&str]) -> PathBuf {
+    let from = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("studies")
+        .join(format!("{name}.toml"));
+    let mut doc: toml::Table = std::fs::read_to_string(&from).unwrap().parse().unwrap();
+    let dropped = |t: &toml::Value| {
+        ["id", "sweep", "refinement"].iter().any(|k| {
+            t.get(k)
+                .and_then(|v| v.as_str())
+                .is_some_and(|v| drop.contains(&v))
+        })
+    };
+    let mut removed = 0;
+    for (key, value) in doc.iter_mut() {
+        if let toml::Value::Array(items) = value {
+            let before = items.len();
+            items.retain(|t| !(t.is_table() && dropped(t)));
+            removed += before - items.len();
+            assert!(
+                key != "sweeps" || !items.is_empty(),
+                "{name}: every sweep dropped"
+            );
+        }
+    }
+    assert!(removed >= drop.len(), "{name}: some of {drop:?} not found");
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(dir.join(format!("{name}.toml")), toml::to_string(&doc).unwrap()).unwrap();
+    dir.to_path_buf()
+}
