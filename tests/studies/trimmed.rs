@@ -36,3 +36,26 @@ pub fn write(dir: &Path, name: &str, drop: &[&str]) -> PathBuf {
     std::fs::write(dir.join(format!("{name}.toml")), toml::to_string(&doc).unwrap()).unwrap();
     dir.to_path_buf()
 }
+
+/// A rerun (of a cut study) against the first run: it ran at least `min_cases` cases, and
+/// each case's record and output equal those of the first run's case with the same id.
+pub fn assert_rerun_equal<C, O>(
+    again: (&[C], &[O]),
+    first: (&[C], &[O]),
+    min_cases: usize,
+    id: impl Fn(&C) -> &str,
+) where
+    C: PartialEq + std::fmt::Debug,
+    O: PartialEq + std::fmt::Debug,
+{
+    assert!(again.0.len() >= min_cases, "{} cases", again.0.len());
+    for (case, output) in again.0.iter().zip(again.1) {
+        let at = first
+            .0
+            .iter()
+            .position(|c| id(c) == id(case))
+            .unwrap_or_else(|| panic!("{} not in the first run", id(case)));
+        assert_eq!(case, &first.0[at], "{}", id(case));
+        assert_eq!(output, &first.1[at], "{}", id(case));
+    }
+}
