@@ -231,7 +231,12 @@ pub fn report_markdown(results: &CompactionResults, not_drawn: &[super::NotDrawn
             .map(|c| (c.id.as_str(), c.status, c.failure.as_ref())),
     ));
     s.push_str(&super::figures_markdown(
-        spec.figures.iter().map(|f| (f.title.as_str(), f.id.as_str())),
+        super::figures_in_tier(
+            &results.study.figures,
+            &results.study.sweeps,
+            results.provenance.tier,
+        )
+        .map(|f| (f.title.as_str(), f.id.as_str())),
         not_drawn,
     ));
     s
@@ -413,7 +418,11 @@ pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
     for p in &results.study.paper_residuals {
         files.text(&p.file, &residual_table(&results, p))?;
     }
-    for f in &results.study.figures {
+    for f in super::figures_in_tier(
+        &results.study.figures,
+        &results.study.sweeps,
+        results.provenance.tier,
+    ) {
         files.figure(
             &f.id,
             render_figure(&results, &domains, dir, f)?,

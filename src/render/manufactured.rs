@@ -134,7 +134,12 @@ pub fn report_markdown(results: &Results, not_drawn: &[super::NotDrawn]) -> Stri
             .map(|c| (c.id.as_str(), c.status, c.failure.as_ref())),
     ));
     s.push_str(&super::figures_markdown(
-        study.figures.iter().map(|f| (f.title.as_str(), f.id.as_str())),
+        super::figures_in_tier(
+            &results.study.figures,
+            &results.study.sweeps,
+            results.provenance.tier,
+        )
+        .map(|f| (f.title.as_str(), f.id.as_str())),
         not_drawn,
     ));
     s
@@ -216,7 +221,11 @@ pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
     let results: Results = read_results(dir)?;
     let domains: BTreeMap<String, CasePoints> = read_json(&dir.join("domains.json"))?;
     let mut files = super::Files::new(dir);
-    for f in &results.study.figures {
+    for f in super::figures_in_tier(
+        &results.study.figures,
+        &results.study.sweeps,
+        results.provenance.tier,
+    ) {
         files.figure(
             &f.id,
             render_figure(&results, &domains, dir, f)?,

@@ -11,6 +11,7 @@ pub mod methods;
 
 use crate::study::checks::{check_counts, CheckRecord, GciRecord};
 use crate::study::results::{write_text, CaseRecordOf, CaseStatus, FailureRecord, Timing};
+use crate::study::vocabulary::{SweepFigure, TieredSweep};
 use crate::study::{StudyError, Tier};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -32,6 +33,22 @@ pub fn index_page(entries: &[IndexEntry]) -> String {
         s.push_str(&e.markdown);
     }
     s
+}
+
+/// The figures whose sweep runs in `tier`: a full-tier-only sweep's figures are not part of a
+/// quick run (neither drawn nor reported missing). A figure naming no known sweep is kept, so
+/// that the renderer reports it.
+pub(crate) fn figures_in_tier<'a, F: SweepFigure, S: TieredSweep>(
+    figures: &'a [F],
+    sweeps: &'a [S],
+    tier: Tier,
+) -> impl Iterator<Item = &'a F> {
+    figures.iter().filter(move |f| {
+        sweeps
+            .iter()
+            .find(|s| s.id() == f.sweep())
+            .is_none_or(|s| s.runs_in(tier))
+    })
 }
 
 /// The `## Figures` section of a report: each figure's title and image (id.svg), or for a

@@ -338,3 +338,16 @@ pub fn exactly_two<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D
 pub fn points_grid(p: usize, dimension: usize) -> String {
     vec![p.to_string(); dimension.max(1)].join("×")
 }
+
+/// A sweep that may run in the full tier only, and a figure drawing one: what a renderer needs
+/// to leave a full-tier sweep's figures out of a quick run.
+pub trait TieredSweep {
+    fn id(&self) -> &str;
+    /// Whether the sweep solves any case in `tier`.
+    fn runs_in(&self, tier: super::Tier) -> bool;
+}
+
+/// A figure of one sweep.
+pub trait SweepFigure {
+    fn sweep(&self) -> &str;
+}

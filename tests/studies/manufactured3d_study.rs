@@ -130,6 +130,8 @@ sweep = "vortex"
 cells = 4
 points_per_cell = 2
 "#;
+    // The appended figure's index: after every figure of the file.
+    let appended = format!("figures[{}].kind", text.matches("[[figures]]").count());
     for (edited, key, says) in [
         (
             text.replace("dimension = 3", "dimension = 4"),
@@ -141,7 +143,7 @@ points_per_cell = 2
             "sweeps[1].methods[0]",
             "fem-hex8",
         ),
-        (format!("{text}{domains}"), "figures[4].kind", "dimension = 2"),
+        (format!("{text}{domains}"), &appended, "dimension = 2"),
     ] {
         match ManufacturedStudy::parse(&edited, "m3.toml") {
             Err(StudyError::Invalid { key: k, allowed, .. }) => {

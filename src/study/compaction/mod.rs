@@ -98,6 +98,22 @@ pub struct CompactionSweep {
     pub quick: SweepQuick,
 }
 
+impl super::vocabulary::TieredSweep for CompactionSweep {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    /// `quick = { skip = true }` makes it a full-tier sweep.
+    fn runs_in(&self, tier: super::Tier) -> bool {
+        tier == super::Tier::Full || !self.quick.skip
+    }
+}
+
+impl super::vocabulary::SweepFigure for CompactionFigure {
+    fn sweep(&self) -> &str {
+        &self.sweep
+    }
+}
+
 /// The result does not depend on γ beyond `tolerance` (relative spread) for h ≤
 /// `max_element_size`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

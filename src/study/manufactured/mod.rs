@@ -94,6 +94,22 @@ pub enum ErrorMeasure {
     Stress,
 }
 
+impl super::vocabulary::TieredSweep for ManufacturedSweep {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    /// `quick = { skip = true }` makes it a full-tier sweep.
+    fn runs_in(&self, tier: super::Tier) -> bool {
+        tier == super::Tier::Full || !self.quick.skip
+    }
+}
+
+impl super::vocabulary::SweepFigure for FigureSpec {
+    fn sweep(&self) -> &str {
+        &self.sweep
+    }
+}
+
 impl ErrorMeasure {
     pub const ALL: [ErrorMeasure; 2] = [ErrorMeasure::Displacement, ErrorMeasure::Stress];
     pub fn name(self) -> &'static str {
