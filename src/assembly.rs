@@ -223,7 +223,10 @@ impl<const D: usize> LoadStepSystem<'_, D> {
     }
 
     fn assemble_tangent_untimed(&mut self) {
-        const CHUNK: usize = 4096;
+        // Points whose local matrices are buffered at once: bounds the buffer's memory; the
+        // result does not depend on it (entries take contributions in point order). Not
+        // tuned.
+        const POINTS_PER_CHUNK: usize = 4096;
         let stride_eq = MAX_POINT_NODES * D;
         self.matrix.clear_values();
         if let Some(lin) = self.linearised.as_deref_mut() {
@@ -239,8 +242,8 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         let mut sizes: Vec<usize> = Vec::new();
         let mut groups: Vec<usize> = Vec::new();
         let threads = rayon::current_num_threads();
-        for start in (0..n).step_by(CHUNK) {
-            let end = (start + CHUNK).min(n);
+        for start in (0..n).step_by(POINTS_PER_CHUNK) {
+            let end = (start + POINTS_PER_CHUNK).min(n);
             let len = end - start;
             let m_max = (start..end).map(|p| table.point(p).0.len()).max().unwrap_or(0);
             let stride_k = (m_max * D) * (m_max * D);
@@ -438,7 +441,7 @@ pub struct StepWorkspace<const D: usize> {
     /// Linearised reactions ([`ResidualNorm::Linearised`]).
     pub linearised: LinearisedReactions,
     /// Where the nodes sit, for an iterative solver's multigrid
-    /// ([`crate::linear::LinearSolver::Cg`]); set by the solver before each step.
+    /// ([`crate::linear::LinearSolver::Iterative`]); set by the solver before each step.
     pub node_geometry: Option<crate::multigrid::NodeGeometry>,
     /// The connectivity never changes (FEM): the sparsity pattern, its symbolic factorisation
     /// and the equations' geometry are built at the first step and kept, as long as the
@@ -494,7 +497,7 @@ impl<const D: usize> StepWorkspace<D> {
             }
             self.matrix.set_pattern(columns);
         }
-        if !kept && self.matrix.solver() == crate::linear::LinearSolver::Cg {
+        if !kept && self.matrix.solver() == crate::linear::LinearSolver::Iterative {
             if let Some(g) = &self.node_geometry {
                 self.matrix
                     .set_geometry(crate::multigrid::DofGeometry::of_equations(g, &dofs));
@@ -547,7 +550,7 @@ impl<const D: usize> StepWorkspace<D> {
             nonzeros: self.matrix.nnz(),
             // A CG run's factor (of a fallback) is not its linear system's cost.
             factor_nonzeros: match self.matrix.solver() {
-                crate::linear::LinearSolver::Cg => 0,
+                crate::linear::LinearSolver::Iterative => 0,
                 _ => self.matrix.stats().factor_nnz,
             },
             iterations: self.matrix.stats().iterations - iterations_before,

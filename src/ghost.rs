@@ -46,8 +46,8 @@ use crate::basis::BasisFamily;
 use crate::dofs::DofMap;
 use crate::error::InputError;
 use crate::grid::Grid;
-use crate::linear::SparseSystem;
 use crate::particles::MaterialPoints;
+use crate::sparse::SparseMatrix;
 use serde::{Deserialize, Serialize};
 
 /// Default of [`GhostSettings::cut_fill`]: a cell is cut (partially filled) when its material
@@ -516,7 +516,7 @@ impl<const D: usize> GhostOperator<D> {
     }
 
     /// `K += K_g` (each displacement component on its own).
-    pub fn add_tangent(&self, dofs: &DofMap, matrix: &mut SparseSystem) {
+    pub fn add_tangent(&self, dofs: &DofMap, matrix: &mut SparseMatrix) {
         let m = face_nodes(D);
         let mut eqs = [None; MAX_FACE_NODES * 3];
         for (a, nodes) in &self.faces {

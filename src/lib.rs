@@ -8,10 +8,14 @@
 //! [`grid`] (regular background grid) → [`basis`] (MPM / GIMP weights, eqs 7–10) →
 //! [`assembly`] (per-point residual and tangent, eqs 27–29, 36, 41) with [`kinematics`]
 //! (ΔF, log strain, spatial tangent; eqs 15–19, 25, 30–36) and [`constitutive`] (eq 14) →
-//! [`linear`] (sparse LU, or LDLᵀ/LLᵀ for symmetric tangents, with cached symbolic
-//! factorisation) → [`newton`] (eqs 22–23) → [`mpm`] (load steps, commit, domain update
-//! eqs 37–39). [`fem`] runs the same assembly, kinematics and Newton on Gauss points
-//! ([`quadrature`]) of updated-Lagrangian line and plane-strain quadrilateral elements, the
+//! [`linear`] (the solver strategy: a direct factorisation, or multigrid-preconditioned CG
+//! with GMRES and direct fallbacks) → [`newton`] (eqs 22–23) → [`mpm`] (load steps, commit,
+//! domain update eqs 37–39). The solver floors, each importing only those below it
+//! (`tests/verification/layering.rs`): [`sparse`] (CSC assembly storage, CSR products) →
+//! [`direct`] (faer LU, LDLᵀ, LLᵀ with cached symbolic analysis) and [`krylov`] (PCG,
+//! GMRES) → [`multigrid`] (the geometric V-cycle preconditioner) → [`linear`]. [`fem`] runs
+//! the same assembly, kinematics and Newton on Gauss points ([`quadrature`]) of
+//! updated-Lagrangian line (1D), Q4/Q8 (plane strain) and Hex8/Hex20 (3D) elements, the
 //! paper's comparators. [`problems`] holds the paper's
 //! examples with their analytical solutions; [`norms`] the error measures (eqs 46–47).
 //!
@@ -39,6 +43,7 @@ pub mod assembly;
 pub mod atomic_file;
 pub mod basis;
 pub mod constitutive;
+pub mod direct;
 pub mod dofs;
 pub mod error;
 pub mod fem;
@@ -46,6 +51,7 @@ pub mod ghost;
 pub mod grid;
 pub mod kinds;
 pub mod kinematics;
+pub mod krylov;
 pub mod linear;
 pub mod load_stepping;
 pub mod method;
@@ -62,6 +68,7 @@ pub mod quadrature;
 pub mod render;
 #[cfg(feature = "seeded-bugs")]
 pub mod seeded;
+pub mod sparse;
 pub mod study;
 pub mod tensor;
 pub mod vtk;

@@ -1,8 +1,14 @@
-//! Sparse tangent storage and solves (faer). The pattern is built once per load step from
+//! The solver strategy: how a Newton system is solved (a direct factorisation, or
+//! multigrid-preconditioned CG with its GMRES and direct fallbacks), when a multigrid is
+//! reused, and what the solves cost. The storage is [`crate::sparse::SparseMatrix`], which
+//! [`SparseSystem`] dereferences to for assembly; the factorisations are [`crate::direct`]'s,
+//! the Krylov methods [`crate::krylov`]'s, the preconditioner [`crate::multigrid`]'s.
+//!
+//! The pattern is built once per load step from
 //! the point–node connectivity, which is fixed within a step (once per analysis for FEM,
 //! whose connectivity never changes: [`crate::assembly::StepWorkspace::fixed_pattern`]); the
 //! symbolic factorisation is computed once for that pattern and only the numeric
-//! factorisation is repeated at each Newton iteration. [`LinearSolver::Cg`] solves
+//! factorisation is repeated at each Newton iteration. [`LinearSolver::Iterative`] solves
 //! iteratively instead, preconditioned by the grid's multigrid ([`crate::multigrid`]).
 //!
 //! The factorisation is LU by default. The tangent of a hyperelastic problem, and of
@@ -13,17 +19,14 @@
 //! that is not numerically positive definite) or yields a non-finite solution, the same
 //! system is solved by LU and the fallback is counted ([`SparseSystem::fallbacks`]).
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, LdltRef, LltRef, SymbolicCholesky, SymmetricOrdering,
-};
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Side};
+use crate::direct::{DirectSolver, Factorisation};
+use crate::krylov::{gmres, pcg};
+use crate::multigrid::{DofGeometry, Hierarchy};
+use crate::sparse::{Csr, CsrMirror, SparseMatrix};
 use serde::{Deserialize, Serialize};
 
-/// Which sparse factorisation solves the Newton systems.
+/// How the Newton systems are solved: one of three sparse factorisations, or the iterative
+/// strategy (multigrid-preconditioned CG, then GMRES, then a factorisation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LinearSolver {
@@ -40,9 +43,10 @@ pub enum LinearSolver {
     /// residual ([`SparseSystem::set_tolerance`]); needs the equations' positions
     /// ([`SparseSystem::set_geometry`]). If CG breaks down (a tangent that is not positive
     /// definite) or does not converge, restarted GMRES with the same multigrid solves the
-    /// system ([`crate::multigrid::gmres`]); only if that fails too is it solved by LDLᵀ
-    /// (then LU). Both switches are counted.
-    Cg,
+    /// system ([`crate::krylov::gmres`]); only if that fails too is it solved by LDLᵀ
+    /// (then LU). Both switches are counted. Written `cg` in study files.
+    #[serde(rename = "cg")]
+    Iterative,
 }
 
 /// Default relative tolerance of an iterative solve when no Newton solver has set one.
@@ -59,7 +63,8 @@ pub const REUSE_FACTOR: f64 = 1.5;
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct LinearStats {
     pub solves: usize,
-    /// CG iterations summed over the iterative solves.
+    /// Krylov iterations summed over the iterative solves: CG's, and GMRES's where CG gave up
+    /// ([`Self::gmres_solves`]).
     pub iterations: usize,
     /// Seconds in symbolic analysis, numeric factorisation or multigrid set-up.
     pub setup_seconds: f64,
@@ -85,194 +90,46 @@ impl LinearStats {
     }
 }
 
-/// `Ok` if every entry of a solution is finite, else the singular-tangent error.
-fn finite(x: &[f64]) -> Result<(), String> {
-    if x.iter().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err("the solution of the linear system is not finite (singular tangent)".into())
-    }
-}
-
-/// A square sparse matrix in compressed sparse column form with cached symbolic
-/// factorisations.
+/// A Newton system's matrix with its solver state: the cached factorisations, the kept
+/// multigrid, the fallbacks taken and the statistics. Dereferences to its
+/// [`SparseMatrix`], into which the tangents are assembled.
 #[derive(Debug, Default)]
 pub struct SparseSystem {
-    n: usize,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
-    values: Vec<f64>,
+    matrix: SparseMatrix,
     solver: LinearSolver,
-    symbolic: Option<SymbolicLu<usize>>,
-    symbolic_cholesky: Option<SymbolicCholesky<usize>>,
-    /// Numeric factor values of the symmetric factorisation, reused between iterations.
-    factor: Vec<f64>,
+    direct: DirectSolver,
     fallbacks: usize,
-    /// Where the equations sit ([`LinearSolver::Cg`]).
-    geometry: Option<crate::multigrid::DofGeometry>,
+    /// Where the equations sit ([`LinearSolver::Iterative`]).
+    geometry: Option<DofGeometry>,
     /// Relative residual an iterative solve must reach (0: the default).
     tolerance: f64,
     stats: LinearStats,
     /// The multigrid of an earlier matrix of this pattern and the CG iterations it took when
     /// fresh ([`Self::solve_cg`] reuses it).
-    hierarchy: Option<(Box<crate::multigrid::Hierarchy>, usize)>,
-    /// The LU factor of the last [`Self::factorize`] under [`LinearSolver::Lu`].
-    lu: Option<Lu<usize, f64>>,
+    hierarchy: Option<(Box<Hierarchy>, usize)>,
     /// The row-compressed copy CG multiplies with, kept per pattern ([`CsrMirror`]).
     mirror: Option<CsrMirror>,
 }
 
-/// The row-compressed copy of a column-compressed matrix, kept per pattern: its structure and
-/// where each entry sits in the column-compressed values (`from`) are built once, and each
-/// solve only gathers the current values, in parallel, into the same arrays: no transpose
-/// and no allocation of a matrix-sized buffer per solve (at 2e6 unknowns, 36e6 non-zeros:
-/// 0.6 s and 577 MB a solve before).
-#[derive(Debug)]
-struct CsrMirror {
-    csr: crate::multigrid::Csr,
-    from: Vec<u32>,
-}
-
-impl CsrMirror {
-    /// The mirror of an `n` × `n` pattern, or `None` if it has 2³² or more non-zeros.
-    fn of_pattern(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Option<Self> {
-        let nnz = row_idx.len();
-        u32::try_from(nnz).ok()?;
-        let mut ptr = vec![0usize; n + 1];
-        for &r in row_idx {
-            ptr[r + 1] += 1;
-        }
-        for i in 0..n {
-            ptr[i + 1] += ptr[i];
-        }
-        let mut next = ptr.clone();
-        let mut idx = vec![0usize; nnz];
-        let mut from = vec![0u32; nnz];
-        // Columns in order, so each row's column indices come out sorted.
-        for c in 0..n {
-            for k in col_ptr[c]..col_ptr[c + 1] {
-                let r = row_idx[k];
-                idx[next[r]] = c;
-                from[next[r]] = k as u32;
-                next[r] += 1;
-            }
-        }
-        let csr = crate::multigrid::Csr {
-            rows: n,
-            cols: n,
-            ptr,
-            idx,
-            val: vec![0.0; nnz],
-        };
-        Some(CsrMirror { csr, from })
-    }
-
-    /// Gather the current values.
-    fn refresh(&mut self, values: &[f64]) {
-        use rayon::prelude::*;
-        self.csr
-            .val
-            .par_iter_mut()
-            .zip(self.from.par_iter())
-            .for_each(|(v, &k)| *v = values[k as usize]);
+impl std::ops::Deref for SparseSystem {
+    type Target = SparseMatrix;
+    fn deref(&self) -> &SparseMatrix {
+        &self.matrix
     }
 }
 
-/// A contiguous range of columns of a [`SparseSystem`] whose values one thread may update
-/// while other threads update other blocks.
-pub struct ColumnBlock<'a> {
-    first_col: usize,
-    end_col: usize,
-    col_ptr: &'a [usize],
-    row_idx: &'a [usize],
-    /// Values of columns `first_col..end_col`, starting at `col_ptr[first_col]`.
-    values: &'a mut [f64],
-}
-
-impl ColumnBlock<'_> {
-    /// Does this block own column `col`?
-    #[inline]
-    pub fn owns(&self, col: usize) -> bool {
-        col >= self.first_col && col < self.end_col
-    }
-    /// `K[row, col] += v` for an owned column, trying position `*hint` first and leaving
-    /// the next position in it: runs of consecutive rows (the dofs of neighbouring nodes)
-    /// then need one search per run instead of one per entry.
-    #[inline]
-    pub fn add_with_hint(&mut self, row: usize, col: usize, v: f64, hint: &mut usize) {
-        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        let k = if *hint >= a && *hint < b && self.row_idx[*hint] == row {
-            *hint
-        } else {
-            match self.row_idx[a..b].binary_search(&row) {
-                Ok(k) => a + k,
-                Err(_) => panic!("entry ({row}, {col}) is not in the sparsity pattern"),
-            }
-        };
-        self.values[k - self.col_ptr[self.first_col]] += v;
-        *hint = k + 1;
-    }
-
-    /// `K[row, col] += v` for an owned column.
-    #[inline]
-    pub fn add(&mut self, row: usize, col: usize, v: f64) {
-        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        match self.row_idx[a..b].binary_search(&row) {
-            Ok(k) => self.values[a + k - self.col_ptr[self.first_col]] += v,
-            Err(_) => panic!("entry ({row}, {col}) is not in the sparsity pattern"),
-        }
+impl std::ops::DerefMut for SparseSystem {
+    fn deref_mut(&mut self) -> &mut SparseMatrix {
+        &mut self.matrix
     }
 }
 
 impl SparseSystem {
-    /// Split the columns into at most `parts` blocks of about equal numbers of entries, for
-    /// parallel assembly: each entry is then updated by exactly one thread.
-    pub fn column_blocks(&mut self, parts: usize) -> Vec<ColumnBlock<'_>> {
-        let parts = parts.max(1).min(self.n.max(1));
-        let nnz = self.row_idx.len();
-        let mut bounds = vec![0];
-        for k in 1..parts {
-            let target = nnz * k / parts;
-            let c = self.col_ptr.partition_point(|&p| p < target).min(self.n);
-            if c > *bounds.last().unwrap() {
-                bounds.push(c);
-            }
-        }
-        bounds.push(self.n);
-        let mut blocks = Vec::with_capacity(bounds.len() - 1);
-        let mut rest: &mut [f64] = &mut self.values;
-        for w in bounds.windows(2) {
-            let len = self.col_ptr[w[1]] - self.col_ptr[w[0]];
-            let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
-            rest = tail;
-            blocks.push(ColumnBlock {
-                first_col: w[0],
-                end_col: w[1],
-                col_ptr: &self.col_ptr,
-                row_idx: &self.row_idx,
-                values: head,
-            });
-        }
-        blocks
-    }
-
     /// Build the pattern from `columns[c]` = rows that may be non-zero in column `c`
-    /// (unsorted, duplicates allowed). Resets the cached symbolic factorisation.
-    pub fn set_pattern(&mut self, mut columns: Vec<Vec<usize>>) {
-        self.n = columns.len();
-        self.col_ptr.clear();
-        self.row_idx.clear();
-        self.col_ptr.push(0);
-        for col in columns.iter_mut() {
-            col.sort_unstable();
-            col.dedup();
-            self.row_idx.extend_from_slice(col);
-            self.col_ptr.push(self.row_idx.len());
-        }
-        self.values.clear();
-        self.values.resize(self.row_idx.len(), 0.0);
-        self.symbolic = None;
-        self.symbolic_cholesky = None;
+    /// (unsorted, duplicates allowed). Resets the cached factorisations and multigrid.
+    pub fn set_pattern(&mut self, columns: Vec<Vec<usize>>) {
+        self.matrix.set_pattern(columns);
+        self.direct.reset();
         self.hierarchy = None;
         self.mirror = None;
     }
@@ -293,8 +150,8 @@ impl SparseSystem {
     }
 
     /// The positions and components of the equations, for the multigrid of
-    /// [`LinearSolver::Cg`] (kept until the next [`Self::set_geometry`]).
-    pub fn set_geometry(&mut self, geometry: crate::multigrid::DofGeometry) {
+    /// [`LinearSolver::Iterative`] (kept until the next [`Self::set_geometry`]).
+    pub fn set_geometry(&mut self, geometry: DofGeometry) {
         self.geometry = Some(geometry);
         self.hierarchy = None;
     }
@@ -310,82 +167,25 @@ impl SparseSystem {
         self.stats
     }
 
-    pub fn dim(&self) -> usize {
-        self.n
-    }
-    pub fn nnz(&self) -> usize {
-        self.row_idx.len()
-    }
-
-    /// Zero the values, keeping the pattern.
-    pub fn clear_values(&mut self) {
-        self.values.iter_mut().for_each(|v| *v = 0.0);
-    }
-
-    /// Position of `(row, col)` in the value array. Panics if it is not in the pattern,
-    /// which would be a bug in pattern construction, not a user error.
-    #[inline]
-    pub fn position(&self, row: usize, col: usize) -> usize {
-        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        match self.row_idx[a..b].binary_search(&row) {
-            Ok(k) => a + k,
-            Err(_) => panic!("entry ({row}, {col}) is not in the sparsity pattern"),
-        }
-    }
-
-    /// `K[row, col] += v`.
-    #[inline]
-    pub fn add(&mut self, row: usize, col: usize, v: f64) {
-        let k = self.position(row, col);
-        self.values[k] += v;
-    }
-
-    /// Value at `(row, col)`, zero outside the pattern.
-    pub fn get(&self, row: usize, col: usize) -> f64 {
-        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        match self.row_idx[a..b].binary_search(&row) {
-            Ok(k) => self.values[a + k],
-            Err(_) => 0.0,
-        }
-    }
-
-    /// `y = K x`.
-    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
-        y.iter_mut().for_each(|v| *v = 0.0);
-        for (c, xc) in x.iter().enumerate().take(self.n) {
-            for k in self.col_ptr[c]..self.col_ptr[c + 1] {
-                y[self.row_idx[k]] += self.values[k] * xc;
-            }
-        }
-    }
-
     /// Solve `K x = rhs` in place, reusing the symbolic factorisation of the pattern.
     pub fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), String> {
-        if self.n == 0 {
+        if self.matrix.dim() == 0 {
             return Ok(());
         }
         self.stats.solves += 1;
-        if self.solver == LinearSolver::Cg {
+        if self.solver == LinearSolver::Iterative {
             let original = rhs.to_vec();
             match self.solve_cg(&original, rhs) {
                 Ok(()) if rhs.iter().all(|v| v.is_finite()) => return Ok(()),
                 _ => {
                     self.fallbacks += 1;
                     rhs.copy_from_slice(&original);
-                    let solver = std::mem::replace(&mut self.solver, LinearSolver::Ldlt);
-                    let out = self.solve_direct(rhs);
-                    self.solver = solver;
-                    return out;
+                    // LDLᵀ, then LU (solve_symmetric's choice for the iterative strategy).
+                    return self.solve_direct(rhs);
                 }
             }
         }
         self.solve_direct(rhs)
-    }
-
-    /// The pattern and values as a row-compressed matrix (the transpose of the stored
-    /// column-compressed one).
-    pub fn to_csr(&self) -> crate::multigrid::Csr {
-        crate::multigrid::Csr::from_csc(self.n, &self.col_ptr, &self.row_idx, &self.values)
     }
 
     /// `x = K⁻¹ b` by CG with the multigrid of the pattern's last fresh build while it stays
@@ -397,16 +197,17 @@ impl SparseSystem {
     fn solve_cg(&mut self, b: &[f64], x: &mut [f64]) -> Result<(), String> {
         let start = std::time::Instant::now();
         if self.mirror.is_none() {
-            self.mirror = CsrMirror::of_pattern(self.n, &self.col_ptr, &self.row_idx);
+            let a = self.matrix.csc();
+            self.mirror = CsrMirror::of_pattern(a.n, a.col_ptr, a.row_idx);
         }
         let mirror = match self.mirror.take() {
             Some(mut m) => {
-                m.refresh(&self.values);
+                m.refresh(self.matrix.csc().values);
                 m
             }
             // Too many non-zeros for the kept positions: a fresh transpose.
             None => CsrMirror {
-                csr: self.to_csr(),
+                csr: self.matrix.to_csr(),
                 from: vec![],
             },
         };
@@ -419,8 +220,7 @@ impl SparseSystem {
     }
 
     /// [`Self::solve_cg`] with the current matrix in row-compressed form.
-    fn solve_cg_with(&mut self, a: &crate::multigrid::Csr, b: &[f64], x: &mut [f64]) -> Result<(), String> {
-        use crate::multigrid::{gmres, pcg, Hierarchy};
+    fn solve_cg_with(&mut self, a: &Csr, b: &[f64], x: &mut [f64]) -> Result<(), String> {
         let rtol = if self.tolerance > 0.0 {
             self.tolerance
         } else {
@@ -430,7 +230,7 @@ impl SparseSystem {
             // Given up once it needs more than the fresh count allows.
             let allowed = (REUSE_FACTOR * *fresh as f64) as usize + 2;
             let start = std::time::Instant::now();
-            let report = pcg(a, m, b, x, rtol, allowed);
+            let report = pcg(a, m.as_ref(), b, x, rtol, allowed);
             self.stats.charge(crate::profile::Phase::Solve, start);
             self.stats.iterations += report.as_ref().map_or(allowed, |r| r.iterations);
             match report {
@@ -465,49 +265,35 @@ impl SparseSystem {
         Ok(())
     }
 
+    /// The direct factorisation of a direct solver choice (`None` for the iterative one).
+    fn factorisation(&self) -> Option<Factorisation> {
+        match self.solver {
+            LinearSolver::Lu => Some(Factorisation::Lu),
+            LinearSolver::Ldlt => Some(Factorisation::Ldlt),
+            LinearSolver::Llt => Some(Factorisation::Llt),
+            LinearSolver::Iterative => None,
+        }
+    }
+
     /// Factorise (LDLᵀ, LLᵀ or LU) for later [`Self::solve_factorized`].
     pub fn factorize(&mut self) -> Result<(), String> {
-        if self.n == 0 {
+        if self.matrix.dim() == 0 {
             return Ok(());
         }
-        match self.solver {
-            LinearSolver::Ldlt | LinearSolver::Llt => self.factorize_symmetric(),
-            LinearSolver::Lu => {
-                self.lu = Some(self.factor_lu()?);
-                Ok(())
-            }
-            LinearSolver::Cg => Err("factorize: a direct solver only (LDLᵀ, LLᵀ or LU)".into()),
-        }
+        let kind = self
+            .factorisation()
+            .ok_or("factorize: a direct solver only (LDLᵀ, LLᵀ or LU)")?;
+        let out = self.direct.factorize(self.matrix.csc(), kind);
+        self.stats.factor_nnz = self.direct.factor_nnz();
+        out
     }
 
     /// Solve with the factor of the last [`Self::factorize`].
     pub fn solve_factorized(&self, rhs: &mut [f64]) -> Result<(), String> {
-        if self.n == 0 {
+        if self.matrix.dim() == 0 {
             return Ok(());
         }
-        if self.solver == LinearSolver::Lu {
-            let lu = self.lu.as_ref().ok_or("solve_factorized: not factorised")?;
-            let n = self.n;
-            lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, 1));
-            return finite(rhs);
-        }
-        let symbolic = self
-            .symbolic_cholesky
-            .as_ref()
-            .ok_or("solve_factorized: not factorised")?;
-        let par = faer::get_global_parallelism();
-        let scratch = symbolic.solve_in_place_scratch::<f64>(1, par);
-        let mut buf = MemBuffer::try_new(scratch).map_err(|e| format!("{e:?}"))?;
-        let stack = MemStack::new(&mut buf);
-        let n = self.n;
-        let mat = MatMut::from_column_major_slice_mut(rhs, n, 1);
-        match self.solver {
-            LinearSolver::Llt => {
-                LltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, mat, par, stack)
-            }
-            _ => LdltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, mat, par, stack),
-        }
-        finite(rhs)
+        self.direct.solve_in_place(rhs)
     }
 
     /// Factorise (set-up) and solve (solve), LU when a symmetric factorisation fails.
@@ -523,104 +309,38 @@ impl SparseSystem {
             }
         }
         self.solve_lu(rhs)?;
-        finite(rhs)
+        crate::direct::finite(rhs)
     }
 
-    /// LU of the current values, the symbolic analysis cached per pattern.
-    fn factor_lu(&mut self) -> Result<Lu<usize, f64>, String> {
-        let sym = SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx);
-        if self.symbolic.is_none() {
-            self.symbolic = Some(SymbolicLu::try_new(sym).map_err(|e| format!("{e:?}"))?);
-        }
-        let symbolic = self.symbolic.clone().expect("symbolic factorisation present");
-        let mat = SparseColMatRef::new(sym, &self.values);
-        Lu::try_new_with_symbolic(symbolic, mat).map_err(|e| format!("{e:?}"))
-    }
-
+    /// LU of the current values (not kept), then the solve.
     fn solve_lu(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        use faer::linalg::solvers::Solve;
         let start = std::time::Instant::now();
-        let lu = self.factor_lu()?;
+        let lu = self.direct.lu(self.matrix.csc())?;
         self.stats.charge(crate::profile::Phase::Setup, start);
         let start = std::time::Instant::now();
-        let n = self.n;
-        lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, 1));
+        let n = self.matrix.dim();
+        lu.solve_in_place(faer::MatMut::from_column_major_slice_mut(rhs, n, 1));
         self.stats.charge(crate::profile::Phase::Solve, start);
         Ok(())
     }
 
     /// LDLᵀ or LLᵀ of the lower triangle, then the solve.
     fn solve_symmetric(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+        let kind = match self.solver {
+            LinearSolver::Llt => Factorisation::Llt,
+            // The iterative strategy's last resort is LDLᵀ.
+            _ => Factorisation::Ldlt,
+        };
         let start = std::time::Instant::now();
-        let factored = self.factorize_symmetric();
+        let factored = self.direct.factorize(self.matrix.csc(), kind);
+        self.stats.factor_nnz = self.direct.factor_nnz();
         self.stats.charge(crate::profile::Phase::Setup, start);
         factored?;
         let start = std::time::Instant::now();
-        let solved = self.solve_factorized(rhs);
+        let solved = self.direct.solve_in_place(rhs);
         self.stats.charge(crate::profile::Phase::Solve, start);
         solved
-    }
-
-    /// LDLᵀ or LLᵀ of the lower triangle (faer's supernodal/simplicial Cholesky with an AMD
-    /// ordering), symbolic analysis cached per pattern.
-    fn factorize_symmetric(&mut self) -> Result<(), String> {
-        let n = self.n;
-        if self.symbolic_cholesky.is_none() {
-            let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
-            let analysed =
-                factorize_symbolic_cholesky(sym, Side::Lower, SymmetricOrdering::Amd, Default::default())
-                    .map_err(|e| format!("{e:?}"))?;
-            self.symbolic_cholesky = Some(analysed);
-        }
-        let symbolic = self
-            .symbolic_cholesky
-            .as_ref()
-            .expect("symbolic factorisation present");
-        let mat = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx),
-            &self.values,
-        );
-        self.factor.resize(symbolic.len_val(), 0.0);
-        self.stats.factor_nnz = symbolic.len_val();
-        let par = faer::get_global_parallelism();
-        let ldlt = match self.solver {
-            LinearSolver::Ldlt => true,
-            LinearSolver::Llt => false,
-            _ => unreachable!("not a symmetric factorisation"),
-        };
-        let scratch = if ldlt {
-            symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default())
-        } else {
-            symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default())
-        };
-        let mut buf = MemBuffer::try_new(scratch).map_err(|e| format!("{e:?}"))?;
-        let stack = MemStack::new(&mut buf);
-        let side = Side::Lower;
-        if ldlt {
-            symbolic
-                .factorize_numeric_ldlt(
-                    &mut self.factor,
-                    mat,
-                    side,
-                    Default::default(),
-                    par,
-                    stack,
-                    Default::default(),
-                )
-                .map_err(|e| format!("{e:?}"))?;
-        } else {
-            symbolic
-                .factorize_numeric_llt(
-                    &mut self.factor,
-                    mat,
-                    side,
-                    Default::default(),
-                    par,
-                    stack,
-                    Default::default(),
-                )
-                .map_err(|e| format!("{e:?}"))?;
-        }
-        Ok(())
     }
 }
 

@@ -498,7 +498,8 @@ impl<const D: usize> MpmSolver<D> {
 impl<const D: usize> LoadStepping for MpmSolver<D> {
     fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
         let step = self.prepare_step(load_factor).map_err(|f| (f, vec![]))?;
-        if self.settings.linear_solver == crate::linear::LinearSolver::Cg && self.work.node_geometry.is_none()
+        if self.settings.linear_solver == crate::linear::LinearSolver::Iterative
+            && self.work.node_geometry.is_none()
         {
             self.work.node_geometry = Some(crate::multigrid::NodeGeometry::of_grid(&self.grid));
         }

@@ -47,3 +47,12 @@ pub fn identity_outer() -> Tensor4 {
 pub fn outer(a: &Matrix3<f64>, b: &Matrix3<f64>) -> Tensor4 {
     flatten(a) * flatten(b).transpose()
 }
+
+/// Pad a `D`-vector to three components.
+pub fn pad3<const D: usize>(v: &nalgebra::SVector<f64, D>) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for a in 0..D.min(3) {
+        out[a] = v[a];
+    }
+    out
+}

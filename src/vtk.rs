@@ -56,14 +56,7 @@ pub struct UnstructuredGrid {
     pub cell_data: Vec<DataArray>,
 }
 
-/// Pad a `D`-vector to three components.
-pub fn pad3<const D: usize>(v: &SVector<f64, D>) -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for a in 0..D.min(3) {
-        out[a] = v[a];
-    }
-    out
-}
+pub use crate::tensor::pad3;
 
 /// Row-major components of a 3×3 tensor (VTK's 9-component tensor layout).
 fn tensor9(m: &Matrix3<f64>) -> [f64; 9] {

@@ -157,7 +157,7 @@ fn multigrid_iterations() -> (f64, usize) {
     let spec = CompactionSpec {
         element_size: 1.0 / 16.0,
         load_steps: 1,
-        linear_solver: LinearSolver::Cg,
+        linear_solver: LinearSolver::Iterative,
         ..CompactionSpec::default()
     };
     let (mut fem, _) = fem_solver(&spec, QuadElement::Q4).unwrap();

@@ -39,7 +39,7 @@ pub fn solver_from_env() -> LinearSolver {
     match std::env::var("SCALING_SOLVER").as_deref() {
         Ok("lu") => LinearSolver::Lu,
         Ok("llt") => LinearSolver::Llt,
-        Ok("cg") => LinearSolver::Cg,
+        Ok("cg") => LinearSolver::Iterative,
         _ => LinearSolver::Ldlt,
     }
 }
@@ -79,7 +79,7 @@ pub fn time_iteration<const D: usize>(
     }
     matrix.set_pattern(columns);
     matrix.set_solver(solver);
-    if solver == LinearSolver::Cg {
+    if solver == LinearSolver::Iterative {
         let nodes = igimp::multigrid::NodeGeometry::of_grid(&solver_mpm.grid);
         matrix.set_geometry(igimp::multigrid::DofGeometry::of_equations(&nodes, &dofs));
         matrix.set_tolerance(1e-8);
@@ -118,7 +118,7 @@ pub fn time_iteration<const D: usize>(
     sys.matrix.solve_in_place(&mut r2).unwrap(); // numeric only (symbolic cached)
     let solve = t.elapsed().as_secs_f64();
     let after = sys.matrix.stats();
-    if solver == LinearSolver::Cg {
+    if solver == LinearSolver::Iterative {
         println!(
             "  CG: {} iterations, multigrid set-up {:.3} s, iterations {:.3} s, {} fallbacks",
             after.iterations - before.iterations,

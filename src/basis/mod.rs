@@ -245,6 +245,13 @@ impl<const D: usize> PointSupport<D> {
             self.push(node, w, g);
         }
     }
+    /// Add to the weight and gradient of local node `k` (already listed).
+    #[inline]
+    pub fn add_to(&mut self, k: usize, w: f64, g: SVector<f64, D>) {
+        debug_assert!(k < self.len);
+        self.w[k] += w;
+        self.g[k] += g;
+    }
     /// Local node `k`: (flat grid node, S_vp, ∂S_vp/∂x).
     #[inline]
     pub fn node(&self, k: usize) -> (usize, f64, SVector<f64, D>) {

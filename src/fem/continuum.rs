@@ -258,7 +258,7 @@ impl<const D: usize, E: ElementFamily<D>> LoadStepping for ContinuumFem<D, E> {
     fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
         // The multigrid coarsens the initial (structured) mesh: its nodes nest in the coarse
         // grids, which the deformed ones need not.
-        if self.settings.linear_solver == LinearSolver::Cg && self.core.work.node_geometry.is_none() {
+        if self.settings.linear_solver == LinearSolver::Iterative && self.core.work.node_geometry.is_none() {
             self.core.work.node_geometry = Some(crate::multigrid::NodeGeometry::of_mesh(&self.mesh0));
         }
         fem_advance(

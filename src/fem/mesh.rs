@@ -407,3 +407,29 @@ impl<const D: usize, E: ElementFamily<D>> FemMesh<D> for ElementMesh<D, E> {
         }
     }
 }
+
+/// The multigrid's view of a mesh (its geometry adapter lives with the mesh, so the solver
+/// layers need not know the FEM types).
+impl crate::multigrid::NodeGeometry {
+    /// The nodes of an FEM mesh; the spacing is that of the first element's nodes (its
+    /// extent per axis, halved for quadratic elements, whose mid-edge nodes halve it).
+    pub fn of_mesh<const D: usize, E: ElementFamily<D>>(mesh: &ElementMesh<D, E>) -> Self {
+        let mut spacing = [1.0; 3];
+        if mesh.num_elements() > 0 {
+            let nodes = mesh.element_nodes(0);
+            for (a, h) in spacing.iter_mut().enumerate().take(D) {
+                let (lo, hi) = nodes
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &n| {
+                        (lo.min(mesh.nodes[n][a]), hi.max(mesh.nodes[n][a]))
+                    });
+                *h = (hi - lo) / if mesh.element.quadratic() { 2.0 } else { 1.0 };
+            }
+        }
+        crate::multigrid::NodeGeometry {
+            dim: D,
+            positions: mesh.nodes.iter().map(crate::tensor::pad3).collect(),
+            spacing,
+        }
+    }
+}

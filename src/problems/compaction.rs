@@ -351,8 +351,8 @@ fn fem_block<const D: usize, E: ElementFamily<D>>(
         load_steps: spec.load_steps,
         // LDLᵀ unless the spec asks for the iterative solver (its LU default is the material
         // point methods').
-        linear_solver: if spec.linear_solver == LinearSolver::Cg {
-            LinearSolver::Cg
+        linear_solver: if spec.linear_solver == LinearSolver::Iterative {
+            LinearSolver::Iterative
         } else {
             LinearSolver::Ldlt
         },

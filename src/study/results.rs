@@ -53,7 +53,8 @@ pub struct StepRecord {
     /// Non-zeros of the step's last LDLᵀ/LLᵀ factor (0: none, or not recorded).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub factor_nonzeros: usize,
-    /// Conjugate-gradient iterations of the step's solves (0 for direct solves).
+    /// Krylov iterations of the step's solves: CG's, plus GMRES's where CG gave up (0 for
+    /// direct solves).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub linear_iterations: usize,
     /// Accepted stalled at this estimated round-off floor, above the tolerance but within

@@ -18,6 +18,7 @@ mod fem;
 mod fem2d;
 mod fem3d;
 mod hostile;
+mod layering;
 mod manufactured;
 mod multigrid;
 mod patch;

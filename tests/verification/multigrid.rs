@@ -1,16 +1,18 @@
 //! The geometric multigrid and the conjugate-gradient solver behind
-//! `LinearSolver::Cg` (`src/multigrid.rs`): the prolongation reproduces linear fields, the
+//! `LinearSolver::Iterative` (`src/multigrid.rs`): the prolongation reproduces linear fields, the
 //! Galerkin coarse operators stay symmetric positive definite, CG agrees with the direct
 //! solver to the Newton tolerance on the paper's examples with Newton still quadratic, and
 //! the iteration counts stay bounded under refinement.
 
 use igimp::fem::QuadElement;
+use igimp::krylov::{gmres, pcg};
 use igimp::linear::LinearSolver;
 use igimp::load_stepping::{LoadStepping, StepReport};
 use igimp::mpm::MpmSolver;
-use igimp::multigrid::{gmres, pcg, prolongation, Csr, DofGeometry, Hierarchy};
+use igimp::multigrid::{prolongation, DofGeometry, Hierarchy};
 use igimp::newton::check_quadratic;
 use igimp::problems::compaction::{fem_solver, CompactionSpec};
+use igimp::sparse::Csr;
 
 /// A 1D operator on 4,096 nodes of spacing h: −u'' + c u' − σ u by central differences, as a
 /// row-compressed matrix with its multigrid geometry.
@@ -168,7 +170,7 @@ fn assert_quadratic(what: &str, reports: &[StepReport], (small, floor, c): (f64,
 #[test]
 fn cg_agrees_with_the_direct_solver_on_the_fem_compaction_and_newton_stays_quadratic() {
     let (direct, corner, _) = q4_compaction(16, LinearSolver::Ldlt, 5);
-    let (cg, _, reports) = q4_compaction(16, LinearSolver::Cg, 5);
+    let (cg, _, reports) = q4_compaction(16, LinearSolver::Iterative, 5);
     let (a, b) = (direct.displacement(corner)[0], cg.displacement(corner)[0]);
     assert!((a - b).abs() <= 1e-8 * a.abs(), "LDLT {a} vs CG {b}");
     assert_eq!(cg.linear_solver_fallbacks(), 0);
@@ -211,7 +213,7 @@ fn cg_agrees_with_the_direct_solver_on_the_material_point_examples() {
         ..CompactionSpec::default()
     };
     let (lu, _) = run_mpm(spec.mpm_solver().unwrap(), LinearSolver::Lu);
-    let (cg, reports) = run_mpm(spec.mpm_solver().unwrap(), LinearSolver::Cg);
+    let (cg, reports) = run_mpm(spec.mpm_solver().unwrap(), LinearSolver::Iterative);
     let d = relative_difference(&lu, &cg);
     let (stats, fallbacks) = cg.linear_stats();
     println!(
@@ -228,7 +230,7 @@ fn cg_agrees_with_the_direct_solver_on_the_material_point_examples() {
     };
     let (s_lu, loaded) = spec.mpm_solver().unwrap();
     let (lu, _) = run_mpm(s_lu, LinearSolver::Lu);
-    let (cg, reports) = run_mpm(spec.mpm_solver().unwrap().0, LinearSolver::Cg);
+    let (cg, reports) = run_mpm(spec.mpm_solver().unwrap().0, LinearSolver::Iterative);
     let d = relative_difference(&lu, &cg);
     let tip = loaded
         .iter()
@@ -276,7 +278,7 @@ fn cg_agrees_with_the_direct_solver_on_the_material_point_examples() {
     };
     let basis = igimp::basis::Basis::Gimp;
     let (lu, _) = run_mpm(spec.mpm_solver(basis).unwrap(), LinearSolver::Lu);
-    let (cg, reports) = run_mpm(spec.mpm_solver(basis).unwrap(), LinearSolver::Cg);
+    let (cg, reports) = run_mpm(spec.mpm_solver(basis).unwrap(), LinearSolver::Iterative);
     let d = relative_difference(&lu, &cg);
     let (stats, fallbacks) = cg.linear_stats();
     println!(
@@ -298,7 +300,7 @@ fn cg_agrees_with_the_direct_solver_on_the_material_point_examples() {
 fn cg_iterations_stay_bounded_under_refinement() {
     let mut per_solve = vec![];
     for n in [8, 16, 32, 64] {
-        let (fem, _, _) = q4_compaction(n, LinearSolver::Cg, 1);
+        let (fem, _, _) = q4_compaction(n, LinearSolver::Iterative, 1);
         let s = fem.linear_stats();
         assert_eq!(fem.linear_solver_fallbacks(), 0, "h = 1/{n}");
         per_solve.push((n, fem.system_size().0, s.iterations as f64 / s.solves as f64));

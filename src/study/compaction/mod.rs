@@ -89,7 +89,7 @@ pub struct CompactionSweep {
     /// Ghost penalty factors γ (0 = off); defaults to the `[ghost]` section's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ghost_gammas: Option<Vec<f64>>,
-    /// `cg`: the multigrid-preconditioned conjugate gradients ([`crate::linear::LinearSolver::Cg`]) for
+    /// `cg`: the multigrid-preconditioned conjugate gradients ([`crate::linear::LinearSolver::Iterative`]) for
     /// every case of the sweep (ids gain `-cg`); absent: the direct default (LU for the
     /// material point methods, LDLᵀ for FEM).
     #[serde(default, skip_serializing_if = "Option::is_none")]

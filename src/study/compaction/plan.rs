@@ -244,7 +244,7 @@ impl CompactionStudy {
             Some(y) => format!("vm{}", number(y)),
         };
         let mut id = format!("{}-{material}-h{}", method.name(), number(spec.element_size));
-        if spec.linear_solver == crate::linear::LinearSolver::Cg {
+        if spec.linear_solver == crate::linear::LinearSolver::Iterative {
             id.push_str("-cg");
         }
         if !method.is_fem() {
