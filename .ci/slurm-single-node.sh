@@ -59,5 +59,9 @@ for r in (a, b):
     for c in r["cases"]:
         c["wall_seconds"] = 0
 assert a == b, "merged Slurm run differs from the unsharded run"
-print(f"slurm: {len(a['cases'])} cases in 3 array tasks, merged results equal the unsharded run")
+import glob, os
+logs = sorted(os.path.basename(p) for p in glob.glob(f"{out}/sharded/slurm-logs/*.out"))
+assert len(logs) == 4, f"expected 3 shard logs and a merge log under the output folder: {logs}"
+assert not glob.glob("igimp-*.out"), "a Slurm log was written to the repository root"
+print(f"slurm: {len(a['cases'])} cases in 3 array tasks, merged results equal the unsharded run; logs {logs}")
 PY

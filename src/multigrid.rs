@@ -215,6 +215,20 @@ fn is_symmetric(a: &Csr) -> bool {
 pub struct Hierarchy {
     levels: Vec<Level>,
     coarse: DirectSolver,
+    /// The V-cycle's work vectors, one set per level, allocated once with the hierarchy (a
+    /// preconditioner application allocates nothing). Behind a lock because
+    /// [`Preconditioner::apply`] takes `&self`; a Krylov solve applies it from one thread.
+    work: std::sync::Mutex<Vec<LevelWork>>,
+}
+
+/// One level's work vectors: residual and Chebyshev direction (the level's size), the
+/// restricted residual and the coarse correction (the next level's size).
+#[derive(Debug)]
+struct LevelWork {
+    r: Vec<f64>,
+    d: Vec<f64>,
+    bc: Vec<f64>,
+    xc: Vec<f64>,
 }
 
 impl Hierarchy {
@@ -305,34 +319,47 @@ impl Hierarchy {
             };
             coarse.factorize(matrix.csc(), kind)?;
         }
-        Ok(Hierarchy { levels, coarse })
+        let work = levels
+            .iter()
+            .map(|lv| LevelWork {
+                r: vec![0.0; lv.a.rows],
+                d: vec![0.0; lv.a.rows],
+                bc: vec![0.0; lv.p.cols],
+                xc: vec![0.0; lv.p.cols],
+            })
+            .collect();
+        Ok(Hierarchy {
+            levels,
+            coarse,
+            work: std::sync::Mutex::new(work),
+        })
     }
 
     /// `x = M⁻¹ b`: one V-cycle from a zero guess.
     pub fn apply(&self, b: &[f64], x: &mut [f64]) -> Result<(), String> {
-        self.cycle(0, b, x)
+        let mut work = self.work.lock().map_err(|_| "multigrid: work vectors poisoned")?;
+        self.cycle(0, b, x, &mut work)
     }
 
-    fn cycle(&self, l: usize, b: &[f64], x: &mut [f64]) -> Result<(), String> {
+    /// Level `l` of the V-cycle; every work vector is overwritten before it is read, so
+    /// reusing them across applications changes nothing.
+    fn cycle(&self, l: usize, b: &[f64], x: &mut [f64], work: &mut [LevelWork]) -> Result<(), String> {
         if l == self.levels.len() {
             x.copy_from_slice(b);
             return self.coarse.solve_in_place(x);
         }
+        let (w, rest) = work.split_first_mut().expect("a work set per level");
         let lv = &self.levels[l];
         let a = &lv.a;
         x.iter_mut().for_each(|v| *v = 0.0);
-        let n = b.len();
-        let mut r = vec![0.0; n];
-        let mut d = vec![0.0; n];
-        chebyshev(lv, b, x, &mut r, &mut d, true);
-        a.residual(b, x, &mut r);
-        let mut bc = vec![0.0; lv.p.cols];
-        lv.r.mul_vec(&r, &mut bc);
-        let mut xc = vec![0.0; bc.len()];
-        self.cycle(l + 1, &bc, &mut xc)?;
-        lv.p.mul_vec(&xc, &mut r);
-        x.par_iter_mut().zip(&r).for_each(|(xi, ei)| *xi += ei);
-        chebyshev(lv, b, x, &mut r, &mut d, false);
+        let (r, d) = (&mut w.r[..], &mut w.d[..]);
+        chebyshev(lv, b, x, r, d, true);
+        a.residual(b, x, r);
+        lv.r.mul_vec(r, &mut w.bc);
+        self.cycle(l + 1, &w.bc, &mut w.xc, rest)?;
+        lv.p.mul_vec(&w.xc, r);
+        x.par_iter_mut().zip(&*r).for_each(|(xi, ei)| *xi += ei);
+        chebyshev(lv, b, x, r, d, false);
         Ok(())
     }
 }
