@@ -51,12 +51,19 @@ pub enum LinearSolver {
 
 /// Default relative tolerance of an iterative solve when no Newton solver has set one.
 pub const DEFAULT_ITERATIVE_TOLERANCE: f64 = 1e-10;
-/// Most CG iterations of one solve before it switches to GMRES.
+/// Most CG iterations of one solve before it switches to GMRES. A safety bound, not a tuned
+/// value: the multigrid CG takes 5–8 iterations per solve from 4e3 to 1e6 unknowns
+/// (reference/README.md item 33), so a solve that reaches 500 is failing, not slow.
 pub const MAX_CG_ITERATIONS: usize = 500;
-/// Most GMRES iterations of one solve before it falls back to the direct solver.
+/// Most GMRES iterations of one solve before it falls back to the direct solver. Also a
+/// safety bound: GMRES took 7–8 iterations on the indefinite and non-symmetric test
+/// operators and the cantilever's indefinite iterates (item 33); at 300 it had stalled
+/// (the LDLᵀ-coarsened variant stood at 4e-5 there).
 pub const MAX_GMRES_ITERATIONS: usize = 300;
 /// A kept multigrid is rebuilt once a solve needs more than this many times the iterations
-/// it took fresh (plus two).
+/// it took fresh, plus two (a fresh count of 5–8, item 33's, may grow by four to six before
+/// the rebuild; the two keeps tiny counts from rebuilding on a one-iteration change). Not
+/// tuned by a sweep; reuse changes the preconditioner only, never the converged solution.
 pub const REUSE_FACTOR: f64 = 1.5;
 
 /// What the linear solves of a system have cost so far (for the performance figures).

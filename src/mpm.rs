@@ -81,6 +81,8 @@ impl MpmSettings {
             ));
         }
         require_count("load_steps", self.load_steps, 1)?;
+        // A sanity bound, not a tuned limit: every study uses at most a few hundred steps
+        // (cut-backs included), and a count beyond it is a typo that would run for days.
         if self.load_steps > 1_000_000 {
             return Err(InputError::new(
                 "load_steps",

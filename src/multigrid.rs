@@ -265,7 +265,10 @@ impl Hierarchy {
             spacing.iter_mut().for_each(|h| *h *= 2.0);
             let (p, coarse_geo) = prolongation(&geo, origin, spacing);
             if p.cols * 10 > a.rows * 9 {
-                // Not shrinking (e.g. a grid one cell thick along every coarsened axis).
+                // Not shrinking by at least 10 % (e.g. a grid one cell thick along every
+                // coarsened axis): another level would cost a Galerkin product and a
+                // smoother for almost no coarsening. A structured grid coarsens by about
+                // 2^dim per level, so the bound only stops degenerate cases.
                 break;
             }
             let r = p.transpose();
