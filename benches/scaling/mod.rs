@@ -9,12 +9,10 @@ use igimp::mpm::MpmSolver;
 use igimp::newton::NonlinearSystem;
 use std::time::Instant;
 
+/// The process's resident peak in MiB (NaN where /proc is unavailable), from the library's
+/// reader.
 pub fn peak_memory_mib() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("VmHWM:")).map(|l| l.to_string()))
-        .and_then(|l| l.split_whitespace().nth(1).and_then(|v| v.parse::<f64>().ok()))
-        .map_or(f64::NAN, |kib| kib / 1024.0)
+    igimp::profile::peak_resident_bytes().map_or(f64::NAN, |b| b as f64 / (1024.0 * 1024.0))
 }
 
 /// `SCALING_GHOST=<gamma>[:all]`: the ghost penalty (cut faces, or every face); default off.
