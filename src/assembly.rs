@@ -393,7 +393,7 @@ impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
     }
     fn solve_tangent(&mut self, rhs: &mut [f64]) -> Result<(), StepFailure> {
         self.assemble_tangent();
-        self.matrix.solve_in_place(rhs).map_err(StepFailure::Singular)
+        self.matrix.solve_in_place(rhs).map_err(StepFailure::LinearSolve)
     }
     fn reference_norm(&self, norm: ResidualNorm) -> f64 {
         let ext: f64 = self.f_ext.iter().map(|x| x * x).sum();

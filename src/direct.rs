@@ -6,6 +6,7 @@
 //! LDLᵀ and LLᵀ read the lower triangle, need about half of LU's fill and run several times
 //! faster on the symmetric tangents (measured in `tests/verification/fem2d.rs`).
 
+use crate::error::SolverError;
 use crate::sparse::CscRef;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::Solve;
@@ -42,11 +43,11 @@ pub struct DirectSolver {
 }
 
 /// `Ok` if every entry of a solution is finite, else the singular-tangent error.
-pub fn finite(x: &[f64]) -> Result<(), String> {
+pub fn finite(x: &[f64]) -> Result<(), SolverError> {
     if x.iter().all(|v| v.is_finite()) {
         Ok(())
     } else {
-        Err("the solution of the linear system is not finite (singular tangent)".into())
+        Err(SolverError::NotFinite)
     }
 }
 
@@ -66,18 +67,19 @@ impl DirectSolver {
     }
 
     /// LU of `a`, the symbolic analysis cached; the factor is returned, not kept.
-    pub fn lu(&mut self, a: CscRef<'_>) -> Result<Lu<usize, f64>, String> {
+    pub fn lu(&mut self, a: CscRef<'_>) -> Result<Lu<usize, f64>, SolverError> {
         let sym = pattern(&a);
         if self.symbolic.is_none() {
-            self.symbolic = Some(SymbolicLu::try_new(sym).map_err(|e| format!("{e:?}"))?);
+            self.symbolic =
+                Some(SymbolicLu::try_new(sym).map_err(|e| SolverError::Factorisation(format!("{e:?}")))?);
         }
         let symbolic = self.symbolic.clone().expect("symbolic factorisation present");
         let mat = SparseColMatRef::new(sym, a.values);
-        Lu::try_new_with_symbolic(symbolic, mat).map_err(|e| format!("{e:?}"))
+        Lu::try_new_with_symbolic(symbolic, mat).map_err(|e| SolverError::Factorisation(format!("{e:?}")))
     }
 
     /// Factorise `a` for later [`Self::solve_in_place`].
-    pub fn factorize(&mut self, a: CscRef<'_>, kind: Factorisation) -> Result<(), String> {
+    pub fn factorize(&mut self, a: CscRef<'_>, kind: Factorisation) -> Result<(), SolverError> {
         self.last = None;
         match kind {
             Factorisation::Lu => self.lu = Some(self.lu(a)?),
@@ -89,15 +91,18 @@ impl DirectSolver {
 
     /// Solve with the factor of the last [`Self::factorize`]; an error if the solution is
     /// not finite.
-    pub fn solve_in_place(&self, rhs: &mut [f64]) -> Result<(), String> {
+    pub fn solve_in_place(&self, rhs: &mut [f64]) -> Result<(), SolverError> {
         let n = rhs.len();
         if n == 0 {
             return Ok(());
         }
         match self.last {
-            None => Err("solve_factorized: not factorised".into()),
+            None => Err(SolverError::Usage("solve_factorized: not factorised")),
             Some(Factorisation::Lu) => {
-                let lu = self.lu.as_ref().ok_or("solve_factorized: not factorised")?;
+                let lu = self
+                    .lu
+                    .as_ref()
+                    .ok_or(SolverError::Usage("solve_factorized: not factorised"))?;
                 lu.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, 1));
                 finite(rhs)
             }
@@ -105,10 +110,11 @@ impl DirectSolver {
                 let symbolic = self
                     .symbolic_cholesky
                     .as_ref()
-                    .ok_or("solve_factorized: not factorised")?;
+                    .ok_or(SolverError::Usage("solve_factorized: not factorised"))?;
                 let par = faer::get_global_parallelism();
                 let scratch = symbolic.solve_in_place_scratch::<f64>(1, par);
-                let mut buf = MemBuffer::try_new(scratch).map_err(|e| format!("{e:?}"))?;
+                let mut buf =
+                    MemBuffer::try_new(scratch).map_err(|e| SolverError::Factorisation(format!("{e:?}")))?;
                 let stack = MemStack::new(&mut buf);
                 let mat = MatMut::from_column_major_slice_mut(rhs, n, 1);
                 if kind == Factorisation::Llt {
@@ -123,7 +129,7 @@ impl DirectSolver {
 
     /// LDLᵀ or LLᵀ of the lower triangle (faer's supernodal/simplicial Cholesky with an AMD
     /// ordering), symbolic analysis cached per pattern.
-    fn factorize_symmetric(&mut self, a: CscRef<'_>, kind: Factorisation) -> Result<(), String> {
+    fn factorize_symmetric(&mut self, a: CscRef<'_>, kind: Factorisation) -> Result<(), SolverError> {
         if self.symbolic_cholesky.is_none() {
             let analysed = factorize_symbolic_cholesky(
                 pattern(&a),
@@ -131,7 +137,7 @@ impl DirectSolver {
                 SymmetricOrdering::Amd,
                 Default::default(),
             )
-            .map_err(|e| format!("{e:?}"))?;
+            .map_err(|e| SolverError::Factorisation(format!("{e:?}")))?;
             self.symbolic_cholesky = Some(analysed);
         }
         let symbolic = self
@@ -147,7 +153,8 @@ impl DirectSolver {
         } else {
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default())
         };
-        let mut buf = MemBuffer::try_new(scratch).map_err(|e| format!("{e:?}"))?;
+        let mut buf =
+            MemBuffer::try_new(scratch).map_err(|e| SolverError::Factorisation(format!("{e:?}")))?;
         let stack = MemStack::new(&mut buf);
         let side = Side::Lower;
         if ldlt {
@@ -161,7 +168,7 @@ impl DirectSolver {
                     stack,
                     Default::default(),
                 )
-                .map_err(|e| format!("{e:?}"))?;
+                .map_err(|e| SolverError::Factorisation(format!("{e:?}")))?;
         } else {
             symbolic
                 .factorize_numeric_llt(
@@ -173,7 +180,7 @@ impl DirectSolver {
                     stack,
                     Default::default(),
                 )
-                .map_err(|e| format!("{e:?}"))?;
+                .map_err(|e| SolverError::Factorisation(format!("{e:?}")))?;
         }
         Ok(())
     }

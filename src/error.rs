@@ -108,8 +108,8 @@ pub enum StepFailure {
     },
     #[error("non-finite residual or update at Newton iteration {iteration}")]
     NonFinite { iteration: usize },
-    #[error("the tangent matrix could not be factorised: {0}")]
-    Singular(String),
+    #[error("the linear solve failed: {0}")]
+    LinearSolve(SolverError),
     #[error("material point {point} left the background grid (position {position})")]
     LeftGrid { point: usize, position: String },
     #[error("material point {point}: {reason}")]
@@ -160,4 +160,28 @@ mod tidy_tests {
             assert_eq!(tidy_numbers(kept), kept);
         }
     }
+}
+
+/// Why a linear solve failed: the error of the solver floors ([`crate::direct`],
+/// [`crate::krylov`], [`crate::multigrid`], [`crate::linear`]), with its real cause.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SolverError {
+    /// faer rejected the factorisation (a structurally or numerically singular matrix, or a
+    /// workspace it could not allocate); faer's own account.
+    #[error("the factorisation failed: {0}")]
+    Factorisation(String),
+    /// The solve finished with a non-finite entry.
+    #[error("the solution of the linear system is not finite (singular tangent)")]
+    NotFinite,
+    /// A Krylov method broke down, diverged or ran out of iterations (its own account, with
+    /// the iteration and residual).
+    #[error("{0}")]
+    Krylov(String),
+    /// The multigrid could not be built or applied.
+    #[error("{0}")]
+    Multigrid(String),
+    /// The solver was used out of order (no factorisation, no geometry for CG, a
+    /// factorisation asked of the iterative strategy): a bug of the caller.
+    #[error("{0}")]
+    Usage(&'static str),
 }

@@ -4,12 +4,13 @@
 //! [`Preconditioner`] (the multigrid V-cycle of [`crate::multigrid`]). Imports only
 //! [`crate::sparse`].
 
+use crate::error::SolverError;
 use crate::sparse::{Csr, CHUNK};
 use rayon::prelude::*;
 
 /// `x = M⁻¹ b` for a fixed preconditioner M.
 pub trait Preconditioner {
-    fn apply(&self, b: &[f64], x: &mut [f64]) -> Result<(), String>;
+    fn apply(&self, b: &[f64], x: &mut [f64]) -> Result<(), SolverError>;
 }
 
 /// uᵀv with a summation order fixed by `CHUNK` alone: partial sums of fixed chunks in
@@ -60,7 +61,7 @@ pub fn pcg(
     x: &mut [f64],
     rtol: f64,
     max_iterations: usize,
-) -> Result<KrylovReport, String> {
+) -> Result<KrylovReport, SolverError> {
     let n = b.len();
     let Some(bnorm) = zero_start(b, x) else {
         return Ok(KrylovReport::EXACT);
@@ -75,9 +76,9 @@ pub fn pcg(
         a.mul_vec(&p, &mut q);
         let pq = dot(&p, &q);
         if !(pq > 0.0 && rz > 0.0) {
-            return Err(format!(
+            return Err(SolverError::Krylov(format!(
                 "CG broke down at iteration {it} (pᵀAp = {pq:e}, rᵀz = {rz:e}): the tangent or the preconditioner is not positive definite"
-            ));
+            )));
         }
         let alpha = rz / pq;
         x.par_iter_mut()
@@ -101,9 +102,9 @@ pub fn pcg(
             .zip(z.par_iter())
             .for_each(|(pi, zi)| *pi = zi + beta * *pi);
     }
-    Err(format!(
+    Err(SolverError::Krylov(format!(
         "CG did not reach the relative residual {rtol:e} in {max_iterations} iterations"
-    ))
+    )))
 }
 
 /// Krylov vectors kept by [`gmres`] before it restarts.
@@ -123,7 +124,7 @@ pub fn gmres(
     x: &mut [f64],
     rtol: f64,
     max_iterations: usize,
-) -> Result<KrylovReport, String> {
+) -> Result<KrylovReport, SolverError> {
     let n = b.len();
     let k = GMRES_RESTART;
     let Some(bnorm) = zero_start(b, x) else {
@@ -169,9 +170,9 @@ pub fn gmres(
             }
             let d = h[j][j].hypot(h[j + 1][j]);
             if d == 0.0 {
-                return Err(format!(
+                return Err(SolverError::Krylov(format!(
                     "GMRES broke down at iteration {iterations} (zero Hessenberg column)"
-                ));
+                )));
             }
             cs[j] = h[j][j] / d;
             sn[j] = h[j + 1][j] / d;
@@ -208,7 +209,9 @@ pub fn gmres(
         a.residual(b, x, &mut r);
         beta = dot(&r, &r).sqrt();
         if !beta.is_finite() {
-            return Err(format!("GMRES diverged at iteration {iterations}"));
+            return Err(SolverError::Krylov(format!(
+                "GMRES diverged at iteration {iterations}"
+            )));
         }
         if beta <= target {
             return Ok(KrylovReport {
@@ -217,8 +220,8 @@ pub fn gmres(
             });
         }
     }
-    Err(format!(
+    Err(SolverError::Krylov(format!(
         "GMRES did not reach the relative residual {rtol:e} in {max_iterations} iterations (at {:e})",
         beta / bnorm
-    ))
+    )))
 }

@@ -20,6 +20,7 @@
 //! system is solved by LU and the fallback is counted ([`SparseSystem::fallbacks`]).
 
 use crate::direct::{DirectSolver, Factorisation};
+use crate::error::SolverError;
 use crate::krylov::{gmres, pcg};
 use crate::multigrid::{DofGeometry, Hierarchy};
 use crate::sparse::{Csr, CsrMirror, SparseMatrix};
@@ -175,7 +176,7 @@ impl SparseSystem {
     }
 
     /// Solve `K x = rhs` in place, reusing the symbolic factorisation of the pattern.
-    pub fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    pub fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         if self.matrix.dim() == 0 {
             return Ok(());
         }
@@ -201,7 +202,7 @@ impl SparseSystem {
     /// than [`REUSE_FACTOR`] times the iterations it took fresh (plus two), or fails; that
     /// solve is then repeated with the fresh hierarchy. Reuse changes the preconditioner, not
     /// the system: every solve still reaches its tolerance on the current matrix.
-    fn solve_cg(&mut self, b: &[f64], x: &mut [f64]) -> Result<(), String> {
+    fn solve_cg(&mut self, b: &[f64], x: &mut [f64]) -> Result<(), SolverError> {
         let start = std::time::Instant::now();
         if self.mirror.is_none() {
             let a = self.matrix.csc();
@@ -227,7 +228,7 @@ impl SparseSystem {
     }
 
     /// [`Self::solve_cg`] with the current matrix in row-compressed form.
-    fn solve_cg_with(&mut self, a: &Csr, b: &[f64], x: &mut [f64]) -> Result<(), String> {
+    fn solve_cg_with(&mut self, a: &Csr, b: &[f64], x: &mut [f64]) -> Result<(), SolverError> {
         let rtol = if self.tolerance > 0.0 {
             self.tolerance
         } else {
@@ -245,10 +246,9 @@ impl SparseSystem {
                 Err(_) => self.stats.rebuilds += 1,
             }
         }
-        let geometry = self
-            .geometry
-            .as_ref()
-            .ok_or("the CG solver needs the equations' positions (SparseSystem::set_geometry)")?;
+        let geometry = self.geometry.as_ref().ok_or(SolverError::Usage(
+            "the CG solver needs the equations' positions (SparseSystem::set_geometry)",
+        ))?;
         let start = std::time::Instant::now();
         self.hierarchy = None;
         let m = Hierarchy::build(a, geometry)?;
@@ -265,7 +265,7 @@ impl SparseSystem {
                 self.stats.charge(crate::profile::Phase::Solve, start);
                 self.stats.gmres_solves += 1;
                 self.stats.iterations += report.as_ref().map_or(MAX_GMRES_ITERATIONS, |r| r.iterations);
-                report.map_err(|e| format!("{cg}; {e}"))?
+                report.map_err(|e| SolverError::Krylov(format!("{cg}; {e}")))?
             }
         };
         self.hierarchy = Some((Box::new(m), report.iterations));
@@ -283,20 +283,20 @@ impl SparseSystem {
     }
 
     /// Factorise (LDLᵀ, LLᵀ or LU) for later [`Self::solve_factorized`].
-    pub fn factorize(&mut self) -> Result<(), String> {
+    pub fn factorize(&mut self) -> Result<(), SolverError> {
         if self.matrix.dim() == 0 {
             return Ok(());
         }
-        let kind = self
-            .factorisation()
-            .ok_or("factorize: a direct solver only (LDLᵀ, LLᵀ or LU)")?;
+        let kind = self.factorisation().ok_or(SolverError::Usage(
+            "factorize: a direct solver only (LDLᵀ, LLᵀ or LU)",
+        ))?;
         let out = self.direct.factorize(self.matrix.csc(), kind);
         self.stats.factor_nnz = self.direct.factor_nnz();
         out
     }
 
     /// Solve with the factor of the last [`Self::factorize`].
-    pub fn solve_factorized(&self, rhs: &mut [f64]) -> Result<(), String> {
+    pub fn solve_factorized(&self, rhs: &mut [f64]) -> Result<(), SolverError> {
         if self.matrix.dim() == 0 {
             return Ok(());
         }
@@ -304,7 +304,7 @@ impl SparseSystem {
     }
 
     /// Factorise (set-up) and solve (solve), LU when a symmetric factorisation fails.
-    fn solve_direct(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn solve_direct(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         if self.solver != LinearSolver::Lu {
             let original = rhs.to_vec();
             match self.solve_symmetric(rhs) {
@@ -320,7 +320,7 @@ impl SparseSystem {
     }
 
     /// LU of the current values (not kept), then the solve.
-    fn solve_lu(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn solve_lu(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         use faer::linalg::solvers::Solve;
         let start = std::time::Instant::now();
         let lu = self.direct.lu(self.matrix.csc())?;
@@ -333,7 +333,7 @@ impl SparseSystem {
     }
 
     /// LDLᵀ or LLᵀ of the lower triangle, then the solve.
-    fn solve_symmetric(&mut self, rhs: &mut [f64]) -> Result<(), String> {
+    fn solve_symmetric(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         let kind = match self.solver {
             LinearSolver::Llt => Factorisation::Llt,
             // The iterative strategy's last resort is LDLᵀ.
@@ -405,6 +405,29 @@ mod tests {
     /// solve that reuses the cached symbolic analysis); on a symmetric indefinite system LLᵀ
     /// fails and falls back to LU, while LDLᵀ still solves it (the shift avoids the exact zero
     /// pivots an integer indefinite matrix can produce without pivoting).
+    /// A singular system fails with its cause, not a generic "could not be factorised": a
+    /// zero matrix is rejected by faer's LU (or gives a non-finite solution), and the step
+    /// failure says it was the linear solve.
+    #[test]
+    fn a_singular_system_reports_its_cause() {
+        let mut sys = SparseSystem::default();
+        sys.set_pattern(vec![vec![0], vec![1]]);
+        let mut rhs = [1.0, 1.0];
+        let e = sys.solve_in_place(&mut rhs).unwrap_err();
+        assert!(
+            matches!(e, SolverError::Factorisation(_) | SolverError::NotFinite),
+            "{e:?}"
+        );
+        let failure = crate::error::StepFailure::LinearSolve(e);
+        assert!(
+            failure.to_string().starts_with("the linear solve failed: "),
+            "{failure}"
+        );
+        // Asking the iterative strategy for a factorisation is the caller's mistake.
+        sys.set_solver(LinearSolver::Iterative);
+        assert!(matches!(sys.factorize(), Err(SolverError::Usage(_))));
+    }
+
     #[test]
     fn symmetric_factorisations_match_lu() {
         for (shift, definite) in [(0.5, true), (-4.877, false)] {

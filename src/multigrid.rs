@@ -29,6 +29,7 @@
 //! (right-preconditioned GMRES) and alg. 12.1 (Chebyshev).
 
 use crate::direct::{DirectSolver, Factorisation};
+use crate::error::SolverError;
 use crate::krylov::Preconditioner;
 use crate::sparse::{Csr, SparseMatrix};
 use rayon::prelude::*;
@@ -234,14 +235,14 @@ struct LevelWork {
 impl Hierarchy {
     /// The hierarchy of `a` (symmetric, the equations of `geometry`): coarse levels of twice
     /// the spacing until at most [`COARSE_SIZE`] equations remain or a level stops shrinking.
-    pub fn build(fine: &Csr, geometry: &DofGeometry) -> Result<Self, String> {
+    pub fn build(fine: &Csr, geometry: &DofGeometry) -> Result<Self, SolverError> {
         let a = fine;
         if geometry.positions.len() != a.rows || geometry.components.len() != a.rows {
-            return Err(format!(
+            return Err(SolverError::Multigrid(format!(
                 "multigrid: {} equations but geometry for {}",
                 a.rows,
                 geometry.positions.len()
-            ));
+            )));
         }
         let mut origin = [0.0; 3];
         for a_ in 0..geometry.dim {
@@ -276,10 +277,10 @@ impl Hierarchy {
             let diag = a.diagonal();
             if let Some(i) = diag.iter().position(|&d| !(d > 0.0 && d.is_finite())) {
                 // Not positive definite: CG could not use it either.
-                return Err(format!(
+                return Err(SolverError::Multigrid(format!(
                     "multigrid: diagonal entry {i} is {} (not positive)",
                     diag[i]
-                ));
+                )));
             }
             // ℓ1-Jacobi: D_ℓ1 = diag(Σ_j |a_ij|) bounds λ_max(D_ℓ1⁻¹A) by 1 (Gershgorin), so
             // the Chebyshev interval needs no eigenvalue estimate and can never fall short.
@@ -339,14 +340,17 @@ impl Hierarchy {
     }
 
     /// `x = M⁻¹ b`: one V-cycle from a zero guess.
-    pub fn apply(&self, b: &[f64], x: &mut [f64]) -> Result<(), String> {
-        let mut work = self.work.lock().map_err(|_| "multigrid: work vectors poisoned")?;
+    pub fn apply(&self, b: &[f64], x: &mut [f64]) -> Result<(), SolverError> {
+        let mut work = self
+            .work
+            .lock()
+            .map_err(|_| SolverError::Multigrid("multigrid: work vectors poisoned".into()))?;
         self.cycle(0, b, x, &mut work)
     }
 
     /// Level `l` of the V-cycle; every work vector is overwritten before it is read, so
     /// reusing them across applications changes nothing.
-    fn cycle(&self, l: usize, b: &[f64], x: &mut [f64], work: &mut [LevelWork]) -> Result<(), String> {
+    fn cycle(&self, l: usize, b: &[f64], x: &mut [f64], work: &mut [LevelWork]) -> Result<(), SolverError> {
         if l == self.levels.len() {
             x.copy_from_slice(b);
             return self.coarse.solve_in_place(x);
@@ -404,7 +408,7 @@ fn chebyshev(lv: &Level, b: &[f64], x: &mut [f64], r: &mut [f64], d: &mut [f64],
 }
 
 impl Preconditioner for Hierarchy {
-    fn apply(&self, b: &[f64], x: &mut [f64]) -> Result<(), String> {
+    fn apply(&self, b: &[f64], x: &mut [f64]) -> Result<(), SolverError> {
         Hierarchy::apply(self, b, x)
     }
 }

@@ -2,7 +2,8 @@
 //! level: an edge A → B wherever A's code names B by a `crate::`, `super::`, `self::` path or
 //! a child module's name (`pub use` re-exports excepted: they are the module's interface).
 //! The solver floors are checked to import only downwards: `sparse`
-//! nothing, `direct` and `krylov` only `sparse`, `multigrid` neither `linear` nor `fem`.
+//! nothing, `direct` and `krylov` only `sparse` and `error` (which imports nothing),
+//! `multigrid` neither `linear` nor `fem`.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -225,8 +226,9 @@ fn src_has_no_import_cycle() {
         }
     };
     only("sparse", &[]);
-    only("direct", &["sparse"]);
-    only("krylov", &["sparse"]);
+    only("error", &[]);
+    only("direct", &["sparse", "error"]);
+    only("krylov", &["sparse", "error"]);
     for d in &g[&m("multigrid")] {
         assert!(
             !["linear", "fem", "vtk", "assembly"].contains(&name(d).as_str()),
