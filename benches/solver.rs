@@ -7,7 +7,11 @@
 //! - `point_kernel`: kinematics + constitutive update + spatial tangent of one point, linear
 //!   elastic and von Mises (plastic return);
 //! - `assembly`: residual and tangent of a plane-strain Q4 mesh;
-//! - `factorisation`: numeric LU / LDLᵀ / LLᵀ + solve of that tangent.
+//! - `factorisation`: numeric LU / LDLᵀ / LLᵀ + solve of that tangent;
+//! - `galerkin`: the multigrid's coarse operator Pᵀ (A P) of a plane 9-point, 2-component
+//!   matrix, by the crate's row-wise product ([`igimp::sparse::Csr::matmul`]) and by faer's
+//!   `sparse_sparse_matmul` (symbolic + numeric each time, as a new hierarchy needs; faer is
+//!   built without its rayon feature, so sequential: compare with `RAYON_NUM_THREADS=1`).
 //!
 //! `cargo bench --bench solver`
 
@@ -19,8 +23,10 @@ use igimp::grid::Grid;
 use igimp::kinematics::{evaluate_point, PointState};
 use igimp::linear::LinearSolver;
 use igimp::load_stepping::LoadStepping;
+use igimp::multigrid::{prolongation, DofGeometry};
 use igimp::newton::NonlinearSystem;
 use igimp::problems::column::ColumnSpec;
+use igimp::sparse::Csr;
 use nalgebra::{Matrix3, SMatrix, SVector};
 use serde::Deserialize;
 use std::hint::black_box;
@@ -32,6 +38,11 @@ struct Sizes {
     families: FamilySizes,
     assembly: MeshSizes,
     factorisation: FactorSizes,
+    galerkin: GalerkinSizes,
+}
+#[derive(Deserialize)]
+struct GalerkinSizes {
+    nodes_per_axis: Vec<usize>,
 }
 #[derive(Deserialize)]
 struct LoadStepSizes {
@@ -350,9 +361,107 @@ fn factorisation(c: &mut Criterion) {
     group.finish();
 }
 
+/// A plane n × n node grid, two components per node, every component of every node coupled
+/// to those of its 8 neighbours (the Q4 stencil), with deterministic values; and its geometry.
+fn stencil_matrix(n: usize) -> (Csr, DofGeometry) {
+    let (mut ptr, mut idx, mut val) = (vec![0], vec![], vec![]);
+    let mut geometry = DofGeometry {
+        dim: 2,
+        spacing: [1.0, 1.0, 1.0],
+        ..DofGeometry::default()
+    };
+    for j in 0..n {
+        for i in 0..n {
+            for c in 0..2 {
+                geometry.positions.push([i as f64, j as f64, 0.0]);
+                geometry.components.push(c as u8);
+                for jj in j.saturating_sub(1)..(j + 2).min(n) {
+                    for ii in i.saturating_sub(1)..(i + 2).min(n) {
+                        for cc in 0..2 {
+                            let col = 2 * (jj * n + ii) + cc;
+                            idx.push(col);
+                            val.push(if col == 2 * (j * n + i) + c {
+                                8.0
+                            } else {
+                                -1.0 / (1 + col % 7) as f64
+                            });
+                        }
+                    }
+                }
+                ptr.push(idx.len());
+            }
+        }
+    }
+    let m = 2 * n * n;
+    let a = Csr {
+        rows: m,
+        cols: m,
+        ptr,
+        idx,
+        val,
+    };
+    (a, geometry)
+}
+
+/// `A B` of row-compressed matrices by faer: the row-compressed A is the column-compressed
+/// Aᵀ, so faer's Bᵀ Aᵀ in column-compressed form is A B in row-compressed form.
+fn faer_matmul(a: &Csr, b: &Csr) -> Csr {
+    use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+    let at = SparseColMatRef::new(
+        SymbolicSparseColMatRef::new_checked(a.cols, a.rows, &a.ptr, None, &a.idx),
+        &a.val,
+    );
+    let bt = SparseColMatRef::new(
+        SymbolicSparseColMatRef::new_checked(b.cols, b.rows, &b.ptr, None, &b.idx),
+        &b.val,
+    );
+    let c = faer::sparse::linalg::matmul::sparse_sparse_matmul(bt, at, 1.0, faer::Par::Seq).unwrap();
+    let (sym, val) = c.parts();
+    Csr {
+        rows: a.rows,
+        cols: b.cols,
+        ptr: sym.col_ptr().to_vec(),
+        idx: sym.row_idx().to_vec(),
+        val: val.to_vec(),
+    }
+}
+
+fn galerkin(c: &mut Criterion) {
+    let mut group = c.benchmark_group("galerkin");
+    group.sample_size(10);
+    for n in sizes().galerkin.nodes_per_axis {
+        let (a, geometry) = stencil_matrix(n);
+        let (p, _) = prolongation(&geometry, [0.0; 3], [2.0, 2.0, 1.0]);
+        let r = p.transpose();
+        // Both products give the same coarse operator (same pattern, values to round-off).
+        let (ours, theirs) = (r.matmul(&a.matmul(&p)), faer_matmul(&r, &faer_matmul(&a, &p)));
+        assert_eq!(
+            (&ours.ptr, &ours.idx),
+            (&theirs.ptr, &theirs.idx),
+            "galerkin: patterns differ"
+        );
+        let scale = ours.val.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = ours
+            .val
+            .iter()
+            .zip(&theirs.val)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(diff <= 1e-12 * scale, "galerkin: values differ by {diff:e}");
+        let label = format!("{}_unknowns", a.rows);
+        group.throughput(Throughput::Elements(a.nnz() as u64));
+        group.bench_function(format!("csr_matmul_{label}"), |b| {
+            b.iter(|| r.matmul(&a.matmul(&p)))
+        });
+        group.bench_function(format!("faer_matmul_{label}"), |b| {
+            b.iter(|| faer_matmul(&r, &faer_matmul(&a, &p)))
+        });
+    }
+    group.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = load_step, weights, families, point_kernel, assembly, factorisation
+    targets = load_step, weights, families, point_kernel, assembly, factorisation, galerkin
 }
 criterion_main!(benches);

@@ -9,6 +9,7 @@
 
 use crate::constitutive::ConstitutiveModel;
 pub use crate::dofs::{DofMap, SupportTable, MAX_POINT_NODES};
+use crate::dynamics::{Inertia, MassMatrix};
 use crate::error::StepFailure;
 use crate::ghost::GhostOperator;
 use crate::kinematics::{evaluate_point, PointState, PointTrial};
@@ -54,6 +55,8 @@ pub struct LoadStepSystem<'a, const D: usize> {
     pub fixed_forces: &'a mut Vec<f64>,
     /// Linearised reaction update ([`ResidualNorm::Linearised`]); `None`: not tracked.
     pub linearised: Option<&'a mut LinearisedReactions>,
+    /// The inertia term M a₁(Δu) of a dynamic step ([`crate::dynamics`]); `None`: static.
+    pub inertia: Option<Inertia<'a>>,
 }
 
 /// The fixed rows of the tangent at the last assembly and the state they were formed at, for
@@ -151,7 +154,43 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         if let Some(g) = self.ghost {
             g.add_residual(self.dofs, self.du_nodal, f_int, Some(self.fixed_forces));
         }
+        if let Some(inertia) = self.inertia {
+            self.add_inertia_residual(&inertia, f_int);
+        }
         Ok(())
+    }
+
+    /// f += M a₁ with a₁ = Δu/(βΔt²) − ã per nodal dof: consistent, Σ_p m_p S_ap (Σ_b S_bp a₁_b);
+    /// lumped, (Σ_p m_p S_ap) a₁_a. Fixed dofs take theirs into the reactions.
+    fn add_inertia_residual(&mut self, inertia: &Inertia<'_>, f_int: &mut [f64]) {
+        let a1 = |dof: usize| inertia.mass_factor * self.du_nodal[dof] - inertia.predictor[dof];
+        for p in 0..self.states.len() {
+            let (nodes, s, _) = self.table.point(p);
+            let m = inertia.point_masses[p];
+            let mut ap = [0.0; 3];
+            if inertia.mass == MassMatrix::Consistent {
+                for (&n, &w) in nodes.iter().zip(s) {
+                    for (i, a) in ap.iter_mut().enumerate().take(D) {
+                        *a += w * a1(n * D + i);
+                    }
+                }
+            }
+            for (&n, &w) in nodes.iter().zip(s) {
+                for i in 0..D {
+                    let dof = n * D + i;
+                    let f = m
+                        * w
+                        * match inertia.mass {
+                            MassMatrix::Consistent => ap[i],
+                            MassMatrix::Lumped => a1(dof),
+                        };
+                    match self.dofs.eq(dof) {
+                        Some(e) => f_int[e] += f,
+                        None => self.fixed_forces[dof] += f,
+                    }
+                }
+            }
+        }
     }
 
     /// ∂S/∂x_j = ∂S/∂X̃_i (ΔF⁻¹)_ij (eq 36) and the equation numbers of point `p`'s nodes.
@@ -237,6 +276,12 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         let n = self.states.len();
         let (table, dofs, model, states, trials) =
             (self.table, self.dofs, self.model, self.states, &*self.trials);
+        #[cfg(feature = "seeded-bugs")]
+        let inertia = self
+            .inertia
+            .filter(|_| !crate::seeded::active(crate::seeded::Bug::NoMassInTangent));
+        #[cfg(not(feature = "seeded-bugs"))]
+        let inertia = self.inertia;
         let mut local: Vec<f64> = Vec::new();
         let mut eq_buf: Vec<Option<usize>> = Vec::new();
         let mut sizes: Vec<usize> = Vec::new();
@@ -274,6 +319,11 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                     *size = md;
                     let a = t.spatial_tangent(model, &states[p]);
                     let v = t.volume;
+                    // The inertia term's α m_p S_a S_b δ_ik (consistent mass).
+                    let mass = inertia
+                        .filter(|i| i.mass == MassMatrix::Consistent)
+                        .map_or(0.0, |i| i.mass_factor * i.point_masses[p]);
+                    let weights = table.point(p).1;
                     // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V.
                     for kb in 0..nodes.len() {
                         for k in 0..D {
@@ -289,11 +339,14 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                             }
                             for ka in 0..nodes.len() {
                                 for i in 0..D {
-                                    let mut s = 0.0;
+                                    let mut sum = 0.0;
                                     for j in 0..D {
-                                        s += gx[ka][j] * c[i][j];
+                                        sum += gx[ka][j] * c[i][j];
                                     }
-                                    kl[(ka * D + i) * md + kb * D + k] = s;
+                                    if i == k && mass != 0.0 {
+                                        sum += mass * weights[ka] * weights[kb];
+                                    }
+                                    kl[(ka * D + i) * md + kb * D + k] = sum;
                                 }
                             }
                         }
@@ -365,6 +418,19 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         }
         if let Some(g) = self.ghost {
             g.add_tangent(self.dofs, self.matrix);
+        }
+        if let Some(i) = inertia.filter(|i| i.mass == MassMatrix::Lumped) {
+            // α m_a on the diagonal, m_a = Σ_p m_p S_ap.
+            for p in 0..n {
+                let (nodes, s, _) = table.point(p);
+                for (&node, &w) in nodes.iter().zip(s) {
+                    for a in 0..D {
+                        if let Some(e) = dofs.eq(node * D + a) {
+                            self.matrix.add(e, e, i.mass_factor * i.point_masses[p] * w);
+                        }
+                    }
+                }
+            }
         }
     }
 }
@@ -464,6 +530,8 @@ pub struct StepInput<'a, const D: usize> {
     pub nodal_forces: &'a [(usize, f64)],
     /// Ghost penalty of the step, built on the same grid ([`crate::ghost`]).
     pub ghost: Option<&'a GhostOperator<D>>,
+    /// The inertia term of a dynamic step; `None`: quasi-static.
+    pub inertia: Option<Inertia<'a>>,
 }
 
 impl<const D: usize> StepWorkspace<D> {
@@ -523,6 +591,7 @@ impl<const D: usize> StepWorkspace<D> {
             ghost: input.ghost,
             fixed_forces: &mut self.fixed_forces,
             linearised: track.then_some(&mut self.linearised),
+            inertia: input.inertia,
         };
         f(&mut system)
     }
@@ -542,7 +611,7 @@ impl<const D: usize> StepWorkspace<D> {
         })
     }
 
-    /// The size of the last step's system and the CG iterations since `iterations_before`
+    /// The size of the last step's system and the Krylov iterations (CG and GMRES) since `iterations_before`
     /// (the matrix's count before the step's solves).
     pub fn linear_record(&self, iterations_before: usize) -> crate::load_stepping::LinearRecord {
         crate::load_stepping::LinearRecord {

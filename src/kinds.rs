@@ -5,8 +5,9 @@
 //! (`src/render/<x>.rs`) and one line in [`KINDS`].
 
 use crate::render::{self, IndexEntry, Rendered};
+use crate::study::bar::BarStudy;
 use crate::study::cantilever::CantileverStudy;
-use crate::study::column::StudySpec;
+use crate::study::column::ColumnStudy;
 use crate::study::compaction::CompactionStudy;
 use crate::study::engine::{self, RunOptions, StudyKind};
 use crate::study::manufactured::ManufacturedStudy;
@@ -16,10 +17,11 @@ use std::path::{Path, PathBuf};
 
 /// Every study kind.
 pub const KINDS: &[Kind] = &[
-    Kind::of::<StudySpec>(render::column::render, render::column::index_entry),
+    Kind::of::<ColumnStudy>(render::column::render, render::column::index_entry),
     Kind::of::<CompactionStudy>(render::compaction::render, render::compaction::index_entry),
     Kind::of::<CantileverStudy>(render::cantilever::render, render::cantilever::index_entry),
     Kind::of::<ManufacturedStudy>(render::manufactured::render, render::manufactured::index_entry),
+    Kind::of::<BarStudy>(render::bar::render, render::bar::index_entry),
 ];
 
 /// What `study` asks of one study file.

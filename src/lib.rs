@@ -45,6 +45,7 @@ pub mod basis;
 pub mod constitutive;
 pub mod direct;
 pub mod dofs;
+pub mod dynamics;
 pub mod error;
 pub mod fem;
 pub mod ghost;

@@ -48,8 +48,8 @@ impl StepReport {
 }
 
 /// The linear systems of one converged increment: unknowns and non-zeros of its tangent, the
-/// non-zeros of its last LDLᵀ/LLᵀ factor (0 if none) and the CG iterations of its solves (0
-/// for direct solves).
+/// non-zeros of its last LDLᵀ/LLᵀ factor (0 if none) and the Krylov iterations of its solves
+/// (CG's plus GMRES's where CG gave up; 0 for direct solves).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct LinearRecord {
     pub unknowns: usize,

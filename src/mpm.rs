@@ -3,6 +3,7 @@
 use crate::assembly::{StepInput, StepWorkspace, SupportTable};
 use crate::basis::{Basis, BasisError, BasisFamily, PointSupport};
 use crate::constitutive::ConstitutiveModel;
+use crate::dynamics::{Inertia, Newmark, NewmarkStep};
 use crate::error::{require_count, InputError, StepFailure};
 use crate::ghost::{cell_fill, node_share, GhostOperator, GhostSettings};
 use crate::grid::Grid;
@@ -40,6 +41,10 @@ pub struct MpmSettings {
     /// default here, chosen per problem from measurements.
     #[serde(default)]
     pub ghost: GhostSettings,
+    /// Newmark time integration ([`crate::dynamics`]): the load steps become time steps over
+    /// `duration`; `None` (default): quasi-static.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dynamics: Option<Newmark>,
 }
 
 /// How the committed volume V_p^n of a material point is obtained (eq 28).
@@ -81,6 +86,9 @@ impl MpmSettings {
             ));
         }
         require_count("load_steps", self.load_steps, 1)?;
+        if let Some(n) = &self.dynamics {
+            n.validate()?;
+        }
         // A sanity bound, not a tuned limit: every study uses at most a few hundred steps
         // (cut-backs included), and a count beyond it is a typo that would run for days.
         if self.load_steps > 1_000_000 {
@@ -117,6 +125,19 @@ pub struct MpmSolver<const D: usize> {
     ghost: GhostOperator<D>,
     /// The basis family: `settings.basis`'s, or one given by [`Self::with_family`].
     family: Arc<dyn BasisFamily<D>>,
+    /// Nodal velocity, acceleration and predictor of the current dynamic step.
+    nodal: NodalMotion,
+    /// Time of the committed state (dynamic analyses).
+    time: f64,
+}
+
+/// The grid's motion at the start of a dynamic step, projected from the points, and the
+/// step's Newmark predictor ã (a₁ = Δu/(βΔt²) − ã), per nodal dof.
+#[derive(Debug, Default)]
+struct NodalMotion {
+    velocity: Vec<f64>,
+    acceleration: Vec<f64>,
+    predictor: Vec<f64>,
 }
 
 impl<const D: usize> MpmSolver<D> {
@@ -182,6 +203,8 @@ impl<const D: usize> MpmSolver<D> {
             work: StepWorkspace::default(),
             ghost: GhostOperator::default(),
             family,
+            nodal: NodalMotion::default(),
+            time: 0.0,
         })
     }
 
@@ -245,10 +268,7 @@ impl<const D: usize> MpmSolver<D> {
         Ok(())
     }
 
-    /// Nodal displacement increment Δu of the last converged load step (node-major:
-    /// `node * D + axis`; empty before the first step). The grid is reset every step, so this
-    /// is the only nodal displacement the solver has.
-    /// What the linear solves have cost so far (solves, CG iterations, seconds) and how
+    /// What the linear solves have cost so far (solves, Krylov iterations, seconds) and how
     /// many fell back to another solver.
     pub fn linear_stats(&self) -> (crate::linear::LinearStats, usize) {
         (self.work.matrix.stats(), self.work.matrix.fallbacks())
@@ -259,6 +279,9 @@ impl<const D: usize> MpmSolver<D> {
         (self.work.matrix.dim(), self.work.matrix.nnz())
     }
 
+    /// Nodal displacement increment Δu of the last converged load step (node-major:
+    /// `node * D + axis`; empty before the first step). The grid is reset every step, so this
+    /// is the only nodal displacement the solver has.
     pub fn step_increment(&self) -> &[f64] {
         &self.work.du_nodal
     }
@@ -372,7 +395,7 @@ impl<const D: usize> MpmSolver<D> {
     /// Commit the converged step: states, positions (x += Σ S Δu) and domains (eqs 37/39).
     /// A domain that would collapse (length ≤ 0) fails the increment before anything is
     /// committed, so that the load stepping can retry it with a smaller one.
-    fn commit(&mut self) -> Result<(), StepFailure> {
+    fn commit(&mut self, newmark: Option<NewmarkStep>) -> Result<(), StepFailure> {
         let family = self.family();
         let mut probe = PointSupport::<D>::default();
         let corners_per_point = if family.needs_corners() { 1 << D } else { 0 };
@@ -412,6 +435,9 @@ impl<const D: usize> MpmSolver<D> {
                 .evaluate(&self.grid, &view, &mut probe)
                 .map_err(|e| Self::basis_failure(p, &x, &h, e))?;
         }
+        if let Some(n) = newmark {
+            self.commit_motion(&n);
+        }
         for p in 0..self.points.len() {
             let trial = self.work.trials[p].as_ref().expect("converged trial");
             let new_state = trial.committed();
@@ -435,6 +461,73 @@ impl<const D: usize> MpmSolver<D> {
     }
 }
 
+impl<const D: usize> MpmSolver<D> {
+    /// Time of the committed state (0 for quasi-static analyses).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// The grid's v₀, a₀ of a dynamic step from the points (mass-weighted, zero at the fixed
+    /// dofs) and the step's predictor ã, after the step's supports are built.
+    fn project_motion(&mut self, n: &NewmarkStep, fixed: &[(usize, usize)]) {
+        let dofs = self.grid.num_nodes() * D;
+        let m = &mut self.nodal;
+        for v in [&mut m.velocity, &mut m.acceleration, &mut m.predictor] {
+            v.clear();
+            v.resize(dofs, 0.0);
+        }
+        let mut mass = vec![0.0; self.grid.num_nodes()];
+        let table = &self.work.table;
+        for p in 0..table.num_points() {
+            let (nodes, s, _) = table.point(p);
+            let mp = self.points.mass[p];
+            for (&node, &w) in nodes.iter().zip(s) {
+                mass[node] += w * mp;
+                for a in 0..D {
+                    m.velocity[node * D + a] += w * mp * self.points.velocity[p][a];
+                    m.acceleration[node * D + a] += w * mp * self.points.acceleration[p][a];
+                }
+            }
+        }
+        for (node, &mn) in mass.iter().enumerate() {
+            if mn > 0.0 {
+                for a in 0..D {
+                    m.velocity[node * D + a] /= mn;
+                    m.acceleration[node * D + a] /= mn;
+                }
+            }
+        }
+        for &(node, a) in fixed {
+            m.velocity[node * D + a] = 0.0;
+            m.acceleration[node * D + a] = 0.0;
+        }
+        for k in 0..dofs {
+            m.predictor[k] = n.predictor(m.velocity[k], m.acceleration[k]);
+        }
+    }
+
+    /// The points' velocities and accelerations after a converged dynamic step:
+    /// v_p += Σ_a S_ap Δt((1 − γ) a₀ + γ a₁)_a, a_p = Σ_a S_ap a₁_a ([`crate::dynamics`]).
+    fn commit_motion(&mut self, n: &NewmarkStep) {
+        let table = &self.work.table;
+        let (du, m) = (&self.work.du_nodal, &self.nodal);
+        for p in 0..table.num_points() {
+            let (nodes, s, _) = table.point(p);
+            let (mut dv, mut a1) = (SVector::<f64, D>::zeros(), SVector::<f64, D>::zeros());
+            for (&node, &w) in nodes.iter().zip(s) {
+                for a in 0..D {
+                    let k = node * D + a;
+                    let acc = du[k] * n.mass_factor() - m.predictor[k];
+                    a1[a] += w * acc;
+                    dv[a] += w * n.velocity_change(m.acceleration[k], acc);
+                }
+            }
+            self.points.velocity[p] += dv;
+            self.points.acceleration[p] = a1;
+        }
+    }
+}
+
 /// The [`StepInput`] of a prepared step; a macro so that it borrows the solver's fields, not
 /// the whole solver (the workspace is borrowed mutably beside it).
 macro_rules! step_input {
@@ -448,6 +541,12 @@ macro_rules! step_input {
             point_forces: &$step.forces,
             nodal_forces: &[],
             ghost: $solver.settings.ghost.is_on().then_some(&$solver.ghost),
+            inertia: $step.newmark.map(|n| Inertia {
+                mass_factor: n.mass_factor(),
+                predictor: &$solver.nodal.predictor,
+                mass: $solver.settings.dynamics.map(|d| d.mass).unwrap_or_default(),
+                point_masses: &$solver.points.mass,
+            }),
         }
     };
 }
@@ -459,14 +558,23 @@ struct PreparedStep<const D: usize> {
     fixed: Vec<(usize, usize)>,
     ties: Vec<(usize, usize)>,
     weak_nodes: usize,
+    /// The Newmark step of a dynamic analysis.
+    newmark: Option<NewmarkStep>,
 }
 
 impl<const D: usize> MpmSolver<D> {
-    /// Weights, ghost term, forces and constraints of a step at `load_factor`.
+    /// Weights, ghost term, forces and constraints of a step at `load_factor` (of a dynamic
+    /// analysis: to time `load_factor` × duration, the forces at that time, the grid's motion
+    /// projected and the Newmark predictor formed).
     fn prepare_step(&mut self, load_factor: f64) -> Result<PreparedStep<D>, StepFailure> {
         self.build_supports()?;
         self.build_ghost();
-        let forces = self.external_point_forces(load_factor);
+        let newmark = self.settings.dynamics.map(|d| {
+            let t1 = load_factor * d.duration;
+            (d.step(t1 - self.time), d.load.factor(t1))
+        });
+        let forces = self.external_point_forces(newmark.map_or(load_factor, |n| n.1));
+        let newmark = newmark.map(|n| n.0);
         let (weak, ties) = self.weak_nodes();
         let mut fixed = self.fixed.clone();
         let tied: Vec<usize> = ties.iter().map(|t| t.0).collect();
@@ -475,11 +583,21 @@ impl<const D: usize> MpmSolver<D> {
                 .filter(|n| !tied.contains(n))
                 .flat_map(|&n| (0..D).map(move |a| (n, a))),
         );
+        if let Some(n) = &newmark {
+            if n.dt.is_nan() || n.dt <= 0.0 {
+                return Err(StepFailure::Kinematics {
+                    point: 0,
+                    reason: format!("time step {:e} is not positive", n.dt),
+                });
+            }
+            self.project_motion(n, &fixed);
+        }
         Ok(PreparedStep {
             forces,
             fixed,
             ties,
             weak_nodes: weak.len(),
+            newmark,
         })
     }
 
@@ -510,7 +628,11 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
         let before = self.work.matrix.stats().iterations;
         let report = self.work.solve(&input, &self.settings.newton)?;
         let linear = self.work.linear_record(before);
-        self.commit().map_err(|f| (f, report.residuals.clone()))?;
+        self.commit(step.newmark)
+            .map_err(|f| (f, report.residuals.clone()))?;
+        if let Some(d) = self.settings.dynamics {
+            self.time = load_factor * d.duration;
+        }
         Ok(Increment {
             newton: report,
             weak_nodes: step.weak_nodes,

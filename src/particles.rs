@@ -23,6 +23,10 @@ pub struct MaterialPoints<const D: usize> {
     pub mass: Vec<f64>,
     /// Committed F, current volume and constitutive state.
     pub state: Vec<PointState>,
+    /// Velocity v_p and acceleration a_p (dynamic analyses, [`crate::dynamics`]; zero at
+    /// rest, and untouched by quasi-static ones).
+    pub velocity: Vec<SVector<f64, D>>,
+    pub acceleration: Vec<SVector<f64, D>>,
     /// Domain corners, 2^D per point (axis 0 fastest), for the families that track them
     /// (CPDI); empty otherwise ([`Self::track_corners`]).
     pub corners: Vec<SVector<f64, D>>,
@@ -46,6 +50,8 @@ impl<const D: usize> MaterialPoints<D> {
         self.volume0.push(vol);
         self.mass.push(density * vol);
         self.state.push(PointState::undeformed(vol));
+        self.velocity.push(SVector::zeros());
+        self.acceleration.push(SVector::zeros());
     }
 
     /// Fill the box `[lower, upper]` with a regular lattice whose spacing is the grid spacing

@@ -32,6 +32,8 @@ pub enum Bug {
     CornersAgainstGrid = 7,
     /// TLMPM with the reference gradients ∇₀S used as the start-of-step ones (no Fₙ⁻ᵀ).
     ReferenceGradients = 8,
+    /// The effective tangent of a dynamic step without its mass term M/(βΔt²).
+    NoMassInTangent = 9,
 }
 
 static ACTIVE: AtomicU8 = AtomicU8::new(0);

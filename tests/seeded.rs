@@ -15,6 +15,7 @@
 //! | B-splines without their boundary treatment | partition of unity within 1.5h of the grid's edge |
 //! | CPDI corners moved against the grid | the column study's CPDI rate bands |
 //! | TLMPM with ∇₀S as the start-of-step gradient (no Fₙ⁻ᵀ) | the column study's TLMPM rate bands |
+//! | dynamic tangent without its mass term M/(βΔt²) | Newton order on the vibrating bar (check_quadratic, order ≥ 1.8) |
 
 use igimp::method::Method;
 use igimp::newton::check_quadratic;
@@ -201,10 +202,10 @@ fn spline_unity_defect() -> f64 {
 /// The ids of the failing checks of the column quick tier's `families` sweep cut to one
 /// family and its bands (the other sweeps run no family).
 fn column_bad_checks(family: Method) -> Vec<String> {
-    use igimp::study::column::StudySpec;
+    use igimp::study::column::ColumnStudy;
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/column.toml");
     let text = std::fs::read_to_string(&path).unwrap();
-    let mut study = StudySpec::parse(&text, "column.toml").unwrap();
+    let mut study = ColumnStudy::parse(&text, "column.toml").unwrap();
     study.sweeps.retain(|x| x.id == "families");
     study.sweeps[0].methods = vec![family];
     study
@@ -224,6 +225,38 @@ fn column_bad_checks(family: Method) -> Vec<String> {
         .filter(|c| c.pass != Some(true))
         .map(|c| c.id.clone())
         .collect()
+}
+
+/// Newton's order on a large-amplitude vibrating bar (v₀/c = 0.05, iGIMP, consistent mass):
+/// every step's history must pass check_quadratic (once r ≤ 0.1, r_{k+1} ≤ 10 r_k², order ≥
+/// 1.8), as in tests/verification/dynamics.rs; Err names the first step that does not (or the
+/// failure of the run).
+fn bar_newton_order() -> Result<usize, String> {
+    use igimp::problems::bar::{solve, BarSpec};
+    let spec = BarSpec {
+        velocity: 0.5,
+        elements: 16,
+        steps_per_period: 32,
+        periods: 0.5,
+        newton: igimp::newton::NewtonSettings {
+            tolerance: 1e-11,
+            max_iterations: 30,
+            max_cutbacks: 0,
+            ..Default::default()
+        },
+        ..BarSpec::default()
+    };
+    let o = solve(&spec, Method::IGIMP).map_err(|e| e.to_string())?;
+    if let Some(f) = o.failure {
+        return Err(f.to_string());
+    }
+    let mut checks = 0;
+    for s in &o.steps {
+        checks += check_quadratic(&s.newton.residuals, 0.1, 1e-11, 10.0, 1.8)
+            .map_err(|e| format!("step {}: {e}", s.step))?
+            .ratio_checks;
+    }
+    Ok(checks)
 }
 
 #[test]
@@ -252,6 +285,8 @@ fn every_seeded_bug_is_caught() {
     );
     let d = spline_unity_defect();
     assert!(d < 1e-12, "correct B-splines: |ΣS − 1| = {d:e}");
+    let bar = bar_newton_order().expect("correct dynamic tangent converges quadratically");
+    assert!(bar >= 5, "only {bar} quadratic ratio checks on the bar");
     for family in [Method::CPDI, Method::TLMPM] {
         let bad = column_bad_checks(family);
         assert!(bad.is_empty(), "correct kernels: column checks {bad:?}");
@@ -316,6 +351,16 @@ fn every_seeded_bug_is_caught() {
             "{bug:?} passed every {family:?} band of the column"
         );
     }
+    set(Bug::None);
+
+    // 10. The dynamic tangent without its mass term: Newton on the bar is no longer quadratic.
+    set(Bug::NoMassInTangent);
+    let caught = bar_newton_order();
+    eprintln!("no mass in the dynamic tangent: bar Newton order check -> {caught:?}");
+    assert!(
+        caught.is_err(),
+        "a dynamic tangent without its mass term passed the Newton-order check"
+    );
     set(Bug::None);
 
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.

@@ -243,7 +243,7 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
         self.core.work.matrix.fallbacks()
     }
 
-    /// What the linear solves have cost so far (solves, CG iterations, seconds).
+    /// What the linear solves have cost so far (solves, Krylov iterations, seconds).
     pub fn linear_stats(&self) -> crate::linear::LinearStats {
         self.core.work.matrix.stats()
     }

@@ -65,6 +65,7 @@ pub use updated_lagrangian::{validate_stepping, FemMesh, GaussPoints, MAX_LOAD_S
 
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
+use crate::dynamics::Newmark;
 use crate::error::{require_finite, InputError, StepFailure};
 use crate::load_stepping::{Increment, LoadStepping};
 use crate::newton::NewtonSettings;
@@ -170,6 +171,35 @@ impl LineFem {
     /// The Gauss rule on [−1, 1].
     pub fn rule(&self) -> &GaussRule {
         &self.rule
+    }
+
+    /// Make the analysis dynamic ([`crate::dynamics`]): the load steps become Newmark time
+    /// steps over `newmark.duration`, from the nodal velocities `velocity` (one per node; the
+    /// fixed nodes' are taken as zero) and zero acceleration.
+    pub fn set_dynamics(&mut self, newmark: Newmark, velocity: Vec<f64>) -> Result<(), InputError> {
+        newmark.validate()?;
+        if velocity.len() != self.mesh.num_nodes() || velocity.iter().any(|v| !v.is_finite()) {
+            return Err(InputError::new(
+                "initial velocity",
+                format!("{} values", velocity.len()),
+                format!("one finite value per node ({})", self.mesh.num_nodes()),
+            ));
+        }
+        self.core.dynamics = Some(newmark);
+        self.core.motion.acceleration = vec![0.0; velocity.len()];
+        self.core.motion.velocity = velocity;
+        self.core.motion.time = 0.0;
+        Ok(())
+    }
+
+    /// Nodal velocities of the committed state (dynamic analyses; empty otherwise).
+    pub fn velocity(&self) -> &[f64] {
+        &self.core.motion.velocity
+    }
+
+    /// Time of the committed state (0 for quasi-static analyses).
+    pub fn time(&self) -> f64 {
+        self.core.motion.time
     }
 
     /// Fill the support table: for each Gauss point its element's nodes, N_a(ξ_q) and

@@ -6,6 +6,7 @@
 
 use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
 use crate::constitutive::ConstitutiveModel;
+use crate::dynamics::{Inertia, Newmark, NewmarkStep};
 use crate::error::{require_count, InputError, StepFailure};
 use crate::kinematics::PointState;
 use crate::load_stepping::Increment;
@@ -104,6 +105,20 @@ pub(crate) struct UlCore<const D: usize> {
     pub fixed_dofs: Vec<(usize, usize)>,
     pub step: usize,
     pub work: StepWorkspace<D>,
+    /// Newmark time integration ([`crate::dynamics`]); `None`: quasi-static.
+    pub dynamics: Option<Newmark>,
+    pub motion: NodalState,
+}
+
+/// The nodes' velocity and acceleration (node·D + axis) and the time of the committed state of
+/// a dynamic analysis, and the Newmark step being solved with its predictor ã.
+#[derive(Debug, Default)]
+pub(crate) struct NodalState {
+    pub time: f64,
+    pub velocity: Vec<f64>,
+    pub acceleration: Vec<f64>,
+    predictor: Vec<f64>,
+    pending: Option<(NewmarkStep, f64)>,
 }
 
 impl<const D: usize> UlCore<D> {
@@ -116,7 +131,53 @@ impl<const D: usize> UlCore<D> {
                 fixed_pattern: true,
                 ..StepWorkspace::default()
             },
+            dynamics: None,
+            motion: NodalState::default(),
         }
+    }
+
+    /// The Newmark step to `load_factor` × duration and its predictor from the committed nodal
+    /// velocity and acceleration (zero at the fixed dofs), or `None` for a static step; the
+    /// load factor the loads take at that time.
+    fn prepare_motion(&mut self, num_nodes: usize, load_factor: f64) -> f64 {
+        let Some(d) = self.dynamics else {
+            self.motion.pending = None;
+            return load_factor;
+        };
+        let m = &mut self.motion;
+        let dofs = num_nodes * D;
+        m.velocity.resize(dofs, 0.0);
+        m.acceleration.resize(dofs, 0.0);
+        for &(n, a) in &self.fixed_dofs {
+            m.velocity[n * D + a] = 0.0;
+            m.acceleration[n * D + a] = 0.0;
+        }
+        let t1 = load_factor * d.duration;
+        let step = d.step(t1 - m.time);
+        m.predictor.clear();
+        m.predictor.extend(
+            m.velocity
+                .iter()
+                .zip(&m.acceleration)
+                .map(|(&v, &a)| step.predictor(v, a)),
+        );
+        m.pending = Some((step, t1));
+        d.load.factor(t1)
+    }
+
+    /// After a converged dynamic step: a₁ (N1), v₁ (N2) at every node, and the step's time.
+    fn commit_motion(&mut self) {
+        let m = &mut self.motion;
+        let Some((step, t1)) = m.pending.take() else {
+            return;
+        };
+        let du = &self.work.du_nodal;
+        for k in 0..m.velocity.len() {
+            let a1 = step.acceleration(du[k], m.velocity[k], m.acceleration[k]);
+            m.velocity[k] += step.velocity_change(m.acceleration[k], a1);
+            m.acceleration[k] = a1;
+        }
+        m.time = t1;
     }
 
     /// Build the [`StepInput`] at `load_factor` (the supports must be in `work.table`) and
@@ -129,6 +190,7 @@ impl<const D: usize> UlCore<D> {
         load_factor: f64,
         f: impl FnOnce(&mut StepWorkspace<D>, &StepInput<'_, D>) -> R,
     ) -> R {
+        let load_factor = self.prepare_motion(num_nodes, load_factor);
         // Dead loads: gravity m_q g mapped with N (eq 40) and nodal forces, both ∝ load factor.
         let forces: Vec<SVector<f64, D>> = loads
             .mass
@@ -149,6 +211,12 @@ impl<const D: usize> UlCore<D> {
             point_forces: &forces,
             nodal_forces: &nodal,
             ghost: None,
+            inertia: self.motion.pending.map(|(step, _)| Inertia {
+                mass_factor: step.mass_factor(),
+                predictor: &self.motion.predictor,
+                mass: self.dynamics.map(|d| d.mass).unwrap_or_default(),
+                point_masses: loads.mass,
+            }),
         };
         f(&mut self.work, &input)
     }
@@ -178,6 +246,7 @@ impl<const D: usize> UlCore<D> {
         for (state, new) in states.iter_mut().zip(self.work.committed_states()) {
             *state = new;
         }
+        self.commit_motion();
         Ok(Increment {
             newton: report,
             weak_nodes: 0,

@@ -189,6 +189,7 @@ impl CantileverSpec {
             volume_update: self.volume_update,
             linear_solver: Default::default(),
             ghost: self.ghost,
+            dynamics: None,
         }
     }
 

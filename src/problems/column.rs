@@ -415,6 +415,7 @@ impl ColumnSpec {
             volume_update: Default::default(),
             linear_solver: Default::default(),
             ghost: self.ghost,
+            dynamics: None,
         }
     }
 

@@ -173,6 +173,7 @@ impl CompactionSpec {
             volume_update: Default::default(),
             linear_solver: self.linear_solver,
             ghost: self.ghost,
+            dynamics: None,
         }
     }
 

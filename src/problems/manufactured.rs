@@ -511,6 +511,7 @@ pub(crate) fn mpm_settings(spec: &ManufacturedSpec, method: Method) -> MpmSettin
         volume_update: Default::default(),
         linear_solver: LinearSolver::Lu,
         ghost: Default::default(),
+        dynamics: None,
     }
 }
 

@@ -1,6 +1,7 @@
 //! The paper's examples as problem definitions with their analytical references, and the
 //! manufactured solutions that verify the 2D discretisations where the paper has none.
 
+pub mod bar;
 pub mod cantilever;
 pub mod column;
 pub mod compaction;

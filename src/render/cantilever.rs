@@ -59,7 +59,7 @@ pub fn report_markdown(results: &CantileverResults, not_drawn: &[super::NotDrawn
                 (Some(d), Some(v)) => format!("{d:?} / {v:?}"),
                 _ => "—".into(),
             },
-            r.status.word(),
+            r.solve.status.word(),
             r.end.len(),
             r.load_steps,
             f5(r.u_over_l),
@@ -123,7 +123,7 @@ pub fn report_markdown(results: &CantileverResults, not_drawn: &[super::NotDrawn
             .iter()
             .filter(|x| x.refinement == r.id)
         {
-            let status = results.case(&x.case).map_or("not run", |c| c.status.word());
+            let status = results.case(&x.case).map_or("not run", |c| c.solve.status.word());
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} | {} | {} |",
@@ -187,7 +187,7 @@ pub fn report_markdown(results: &CantileverResults, not_drawn: &[super::NotDrawn
         results
             .cases
             .iter()
-            .map(|c| (c.id.as_str(), c.status, c.failure.as_ref())),
+            .map(|c| (c.id.as_str(), c.solve.status, c.solve.failure.as_ref())),
     ));
     s.push_str(&super::figures_markdown(
         study.figures.iter().map(|f| (f.title.as_str(), f.id.as_str())),
@@ -257,7 +257,7 @@ fn render_figure(
                 }],
                 _ => vec![],
             };
-            let title = match (&rec.failure, rec.status) {
+            let title = match (&rec.solve.failure, rec.solve.status) {
                 (Some(fl), CaseStatus::Failed) => format!("{} (failed at step {})", f.title, fl.step),
                 _ => f.title.clone(),
             };
@@ -399,6 +399,7 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
     let r: Results = read_results(dir)?;
     Ok(super::plane_index_entry(
         (&r.study.name, &r.study.summary, r.provenance.tier),
+        ("the drawn domains", "domains.json"),
         &r.checks,
         &r.study.report_file,
         std::iter::empty(),

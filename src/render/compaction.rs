@@ -46,11 +46,12 @@ pub fn residual_table(results: &CompactionResults, p: &PaperResiduals) -> String
         case.map_or("(not run in this tier)", |c| c.id.as_str())
     );
     let Some(case) = case else { return s };
-    if case.status != CaseStatus::Converged {
+    if case.solve.status != CaseStatus::Converged {
         let _ = writeln!(
             s,
             "The case did not converge: {}.\n",
-            case.failure
+            case.solve
+                .failure
                 .as_ref()
                 .map_or(String::new(), |f| format!("step {}: {}", f.step, f.reason))
         );
@@ -58,7 +59,7 @@ pub fn residual_table(results: &CompactionResults, p: &PaperResiduals) -> String
     let rows = p.residuals.iter().map(Vec::len).max().unwrap_or(0).max(
         p.steps
             .iter()
-            .filter_map(|&st| case.steps.iter().find(|r| r.step == st as usize))
+            .filter_map(|&st| case.solve.steps.iter().find(|r| r.step == st as usize))
             .map(|r| r.residuals.len().saturating_sub(1))
             .max()
             .unwrap_or(0),
@@ -76,6 +77,7 @@ pub fn residual_table(results: &CompactionResults, p: &PaperResiduals) -> String
         let _ = write!(s, "| {k} |");
         for (j, &st) in p.steps.iter().enumerate() {
             let code = case
+                .solve
                 .steps
                 .iter()
                 .find(|r| r.step == st as usize)
@@ -117,13 +119,16 @@ fn figure17_table(results: &CompactionResults) -> String {
     let cell = |c: Option<&&CompactionRecord>| -> String {
         match c {
             None => "—".into(),
-            Some(c) => match (c.status, c.max_horizontal_displacement) {
+            Some(c) => match (c.solve.status, c.max_horizontal_displacement) {
                 (CaseStatus::Converged, Some(u)) => match reference {
                     Some(r) => format!("{u:.5} ({:.4})", u / r.value),
                     None => format!("{u:.5}"),
                 },
                 (CaseStatus::Failed, _) => {
-                    format!("failed at step {}", c.failure.as_ref().map_or(0, |f| f.step))
+                    format!(
+                        "failed at step {}",
+                        c.solve.failure.as_ref().map_or(0, |f| f.step)
+                    )
                 }
                 _ => "rejected".into(),
             },
@@ -182,7 +187,7 @@ fn cases_table(results: &CompactionResults) -> String {
             } else {
                 number(c.ghost_gamma)
             },
-            c.status.word(),
+            c.solve.status.word(),
             u,
             c.weak_nodes_treated,
             if c.steps_cut == 0 {
@@ -190,10 +195,13 @@ fn cases_table(results: &CompactionResults) -> String {
             } else {
                 format!("{} ({})", c.steps_cut, c.cutbacks)
             },
-            if c.steps.is_empty() {
+            if c.solve.steps.is_empty() {
                 "—".into()
             } else {
-                format!("{:.2}", c.newton_iterations as f64 / c.steps.len() as f64)
+                format!(
+                    "{:.2}",
+                    c.solve.newton_iterations as f64 / c.solve.steps.len() as f64
+                )
             }
         );
     }
@@ -205,7 +213,7 @@ fn cases_table(results: &CompactionResults) -> String {
 pub fn report_markdown(results: &CompactionResults, not_drawn: &[super::NotDrawn]) -> String {
     let spec = &results.study;
     let (pass, fail, none) = check_counts(&results.checks);
-    let count = |st| results.cases.iter().filter(|c| c.status == st).count();
+    let count = |st| results.cases.iter().filter(|c| c.solve.status == st).count();
     let mut s = format!(
         "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated. Cases: {} converged, {} failed, {} rejected.\n\n",
         spec.name,
@@ -228,7 +236,7 @@ pub fn report_markdown(results: &CompactionResults, not_drawn: &[super::NotDrawn
         results
             .cases
             .iter()
-            .map(|c| (c.id.as_str(), c.status, c.failure.as_ref())),
+            .map(|c| (c.id.as_str(), c.solve.status, c.solve.failure.as_ref())),
     ));
     s.push_str(&super::figures_markdown(
         super::figures_in_tier(
@@ -281,7 +289,7 @@ fn render_figure(
                     half: d.half,
                 })
                 .collect();
-            let title = match c.status {
+            let title = match c.solve.status {
                 CaseStatus::Converged => f.title.clone(),
                 _ => format!("{} (last converged step)", f.title),
             };
@@ -316,7 +324,7 @@ fn render_figure(
         }
         CompactionFigureKind::Residuals => {
             let step = f.step.unwrap_or(1) as usize;
-            let Some(rec) = case.and_then(|c| c.steps.iter().find(|r| r.step == step)) else {
+            let Some(rec) = case.and_then(|c| c.solve.steps.iter().find(|r| r.step == step)) else {
                 return Ok(None);
             };
             let code: Vec<(f64, f64)> = rec
@@ -438,6 +446,7 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
     let r: Results = read_results(dir)?;
     Ok(super::plane_index_entry(
         (&r.study.name, &r.study.summary, r.provenance.tier),
+        ("the drawn domains", "domains.json"),
         &r.checks,
         &r.study.report_file,
         r.study

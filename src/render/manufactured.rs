@@ -131,7 +131,7 @@ pub fn report_markdown(results: &Results, not_drawn: &[super::NotDrawn]) -> Stri
         results
             .cases
             .iter()
-            .map(|c| (c.id.as_str(), c.status, c.failure.as_ref())),
+            .map(|c| (c.id.as_str(), c.solve.status, c.solve.failure.as_ref())),
     ));
     s.push_str(&super::figures_markdown(
         super::figures_in_tier(
@@ -241,6 +241,7 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
     let r: Results = read_results(dir)?;
     Ok(super::plane_index_entry(
         (&r.study.name, &r.study.summary, r.provenance.tier),
+        ("the drawn domains", "domains.json"),
         &r.checks,
         &r.study.report_file,
         std::iter::empty(),

@@ -3,6 +3,7 @@
 //! Markdown and index helpers here. Nothing here solves: every module imports the results
 //! types only ([`crate::study`]'s records, envelopes and study files).
 
+pub mod bar;
 pub mod cantilever;
 pub mod column;
 pub mod compaction;
@@ -175,10 +176,11 @@ impl<'a> Files<'a> {
     }
 }
 
-/// The index entry of a plane-strain study: its report, tables (title, file) and figures
-/// (title, id) as links.
+/// The index entry of a plane-strain (or bar) study: its report, tables (title, file) and
+/// figures (title, id) as links, and what its side file `data` (in `<name>/`) holds.
 pub(crate) fn plane_index_entry(
     header: (&str, &str, Tier),
+    data: (&str, &str),
     checks: &[CheckRecord],
     report_file: &str,
     tables: impl IntoIterator<Item = (String, String)>,
@@ -197,9 +199,10 @@ pub(crate) fn plane_index_entry(
     for (text, file) in &files {
         let _ = writeln!(s, "- [{text}]({name}/{file})");
     }
+    let (what, file) = data;
     let _ = writeln!(
         s,
-        "- [results.json]({name}/results.json) and the drawn domains in `{name}/domains.json`\n"
+        "- [results.json]({name}/results.json) and {what} in `{name}/{file}`\n"
     );
     IndexEntry {
         markdown: s,
@@ -235,8 +238,8 @@ pub fn checks_markdown(checks: &[CheckRecord]) -> String {
 ///
 /// *Linear systems* (deterministic): unknowns and non-zeros of the last converged step's
 /// tangent (the largest of the run for the material point methods, whose active grid
-/// changes), the non-zeros of its LDLᵀ/LLᵀ factor, Newton iterations and CG iterations over
-/// the converged steps. *Cost* (wall-clock, from `results.json`'s `timing`): each case's
+/// changes), the non-zeros of its LDLᵀ/LLᵀ factor, Newton iterations and Krylov iterations
+/// (CG's plus GMRES's where CG gave up) over the converged steps. *Cost* (wall-clock, from `results.json`'s `timing`): each case's
 /// seconds by phase ([`crate::profile::Phase`]) and its heap peak. Both are empty for results
 /// written before they were recorded.
 /// The load steps accepted stalled at their round-off floor (above the tolerance, within
@@ -267,7 +270,7 @@ pub fn performance_markdown<C: CaseRecordOf>(cases: &[C], timing: &Timing) -> St
         s.push_str(
             "## Linear systems
 
-| case | unknowns | nnz(K) | nnz(L) | Newton iterations | CG iterations |
+| case | unknowns | nnz(K) | nnz(L) | Newton iterations | Krylov iterations |
 |---|---:|---:|---:|---:|---:|
 ",
         );
@@ -305,7 +308,7 @@ pub fn performance_markdown<C: CaseRecordOf>(cases: &[C], timing: &Timing) -> St
 
 Wall seconds on {} threads, by phase: weights (supports, GIMP weights or shape functions, ghost \
 faces), constitutive (point updates and internal force), tangent assembly, set-up (dof map, \
-pattern, factorisation or multigrid) and solve (triangular solves or CG iterations); *other* \
+pattern, factorisation or multigrid) and solve (triangular solves or Krylov iterations); *other* \
 is the rest of the case (load stepping, commits, domain updates, output). Cases run \
 concurrently and share the cores, so these times vary from run to run; the heap peak is the \
 case's own (its largest live heap above what it started with).{}

@@ -6,11 +6,13 @@
 //! [`engine::StudyKind`] (rayon, results in a fixed order, the case store, `--resume`,
 //! `--vtk`, `--shard`/`--merge`) and [`engine::write_outputs`] writes the [`results::Envelope`]
 //! as `results.json`; [`crate::render`] reads only the results files. The kinds: [`column`](mod@column)
-//! (§5.1), [`compaction`] (§5.2), [`cantilever`] (§5.3); [`crate::kinds`] registers them.
+//! (§5.1), [`compaction`] (§5.2), [`cantilever`] (§5.3), [`manufactured`] and the
+//! vibrating [`bar`] (dynamics); [`crate::kinds`] registers them.
 //!
 //! Counts in the files are parsed as signed integers so that a negative value is reported by
 //! validation with its key and allowed range instead of as a type error.
 
+pub mod bar;
 pub mod cantilever;
 pub mod checks;
 pub mod column;

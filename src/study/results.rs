@@ -243,7 +243,7 @@ pub trait CaseRecordOf {
     fn steps(&self) -> &[StepRecord];
 }
 
-/// [`CaseRecordOf`] for a record with `id: String` and `status: CaseStatus` fields.
+/// [`CaseRecordOf`] for a record with `id: String` and `solve: SolveRecord` fields.
 macro_rules! case_record {
     ($record:ty) => {
         impl $crate::study::results::CaseRecordOf for $record {
@@ -251,10 +251,10 @@ macro_rules! case_record {
                 &self.id
             }
             fn status(&self) -> $crate::study::results::CaseStatus {
-                self.status
+                self.solve.status
             }
             fn steps(&self) -> &[$crate::study::results::StepRecord] {
-                &self.steps
+                &self.solve.steps
             }
         }
     };
@@ -262,11 +262,12 @@ macro_rules! case_record {
 pub(crate) use case_record;
 
 /// What every kind records of one solve: status, failure, Newton iterations and the
-/// residual histories of the converged steps.
-#[derive(Debug, Clone, PartialEq)]
+/// residual histories of the converged steps; each kind's record flattens it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SolveRecord {
     pub status: CaseStatus,
     pub failure: Option<FailureRecord>,
+    /// Newton iterations summed over the converged steps.
     pub newton_iterations: usize,
     pub steps: Vec<StepRecord>,
 }

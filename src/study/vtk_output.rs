@@ -180,6 +180,18 @@ pub struct DomainBox {
     pub half: [f64; 3],
 }
 
+impl DomainBox {
+    /// The domain centred at `centre` with half-lengths `half`, in D = 2 or 3 dimensions (a
+    /// plane domain lies in z = 0 with no half-length along z).
+    pub fn new<const D: usize>(centre: [f64; D], half: [f64; D]) -> Self {
+        let pad = |v: [f64; D]| std::array::from_fn(|a| if a < D { v[a] } else { 0.0 });
+        DomainBox {
+            centre: pad(centre),
+            half: pad(half),
+        }
+    }
+}
+
 impl From<[f64; 4]> for DomainBox {
     /// A plane domain from (x, y, half-length x, half-length y).
     fn from(d: [f64; 4]) -> Self {

@@ -46,7 +46,7 @@ fn relative(a: f64, b: f64) -> f64 {
 fn cantilever_stretch_update_completes_and_matches_elastica_and_q8() {
     let r = &quick().results;
     let c = r.case("stretch").unwrap();
-    assert_eq!(c.status, CaseStatus::Converged);
+    assert_eq!(c.solve.status, CaseStatus::Converged);
     assert_eq!(c.end.len(), 50);
     let (u, v) = (c.u_over_l.unwrap(), c.v_over_l.unwrap());
     let e = c.elastica.unwrap();
@@ -62,7 +62,7 @@ fn cantilever_stretch_update_completes_and_matches_elastica_and_q8() {
         e.v_over_l
     );
     let q8 = r.case("q8").unwrap();
-    assert_eq!(q8.status, CaseStatus::Converged, "{:?}", q8.failure);
+    assert_eq!(q8.solve.status, CaseStatus::Converged, "{:?}", q8.solve.failure);
     let (uq, vq) = (q8.u_over_l.unwrap(), q8.v_over_l.unwrap());
     assert!(relative(u, uq) < 0.03, "u/L {u} vs Q8 {uq}");
     assert!(relative(v, vq) < 0.03, "v/L {v} vs Q8 {vq}");
@@ -76,8 +76,8 @@ fn cantilever_stretch_update_completes_and_matches_elastica_and_q8() {
 #[test]
 fn cantilever_f_diagonal_update_collapses_and_is_recorded() {
     let c = quick().results.case("f-diagonal").unwrap();
-    assert_eq!(c.status, CaseStatus::Failed);
-    let f = c.failure.as_ref().unwrap();
+    assert_eq!(c.solve.status, CaseStatus::Failed);
+    let f = c.solve.failure.as_ref().unwrap();
     assert!(f.step > 1 && f.step < 50 && !f.reason.is_empty(), "{f:?}");
     assert_eq!(c.end.len(), f.step - 1);
     let m = &c.min_half_length;
@@ -147,7 +147,13 @@ fn cantilever_every_family_refined_agrees_with_q8() {
     assert_eq!(rows.len(), 7 * 2, "{rows:#?}");
     for row in rows {
         let c = r.case(&row.case).unwrap();
-        assert_eq!(c.status, CaseStatus::Converged, "{}: {:?}", c.id, c.failure);
+        assert_eq!(
+            c.solve.status,
+            CaseStatus::Converged,
+            "{}: {:?}",
+            c.id,
+            c.solve.failure
+        );
     }
     let checks: Vec<_> = r
         .checks

@@ -5,14 +5,14 @@
 //! 2026-12-01: at most 4e-13 for iGIMP and FEM; 2026-12-03: 6e-11 for the other families), and
 //! its Table 1 checks pass.
 
-use igimp::study::column::StudySpec;
+use igimp::study::column::ColumnStudy;
 use igimp::study::engine::{run_in_memory, StudyKind};
 use igimp::study::results::CaseStatus;
 use igimp::study::Tier;
 use std::path::Path;
 
 fn quick(file: &str) -> igimp::study::column::records::ColumnResults {
-    let s = StudySpec::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies").join(file)).unwrap();
+    let s = ColumnStudy::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies").join(file)).unwrap();
     run_in_memory(&s, file, Tier::Quick).unwrap().results
 }
 
@@ -23,7 +23,7 @@ fn column_3d_equals_the_1d_column() {
     let mut compared = 0;
     let mut worst: f64 = 0.0;
     for c in &d3.cases {
-        assert_eq!(c.status, CaseStatus::Converged, "{}", c.id);
+        assert_eq!(c.solve.status, CaseStatus::Converged, "{}", c.id);
         // Hex8 and Hex20 on the prism are the 1D linear and quadratic elements.
         let id_1d =
             c.id.replace("fem-hex8", "fem-linear")
@@ -60,7 +60,7 @@ fn column_3d_equals_the_1d_column() {
     }
     // Newton converges quadratically in 3D, as in 1D.
     for c in &d3.cases {
-        for s in &c.steps {
+        for s in &c.solve.steps {
             igimp::newton::check_quadratic(&s.residuals, 1e-3, 1e-11, 1.0, 1.8)
                 .unwrap_or_else(|e| panic!("{} step {}: {e}", c.id, s.step));
         }

@@ -25,8 +25,8 @@ fn cg_reference_equals_the_direct_solvers_on_the_same_meshes() {
         .unwrap()
         .results;
     for c in &r.cases {
-        assert_eq!(c.status, CaseStatus::Converged, "{}", c.id);
-        for st in &c.steps {
+        assert_eq!(c.solve.status, CaseStatus::Converged, "{}", c.id);
+        for st in &c.solve.steps {
             check_quadratic(&st.residuals, 1e-3, 1e-11, 1.0, 1.8)
                 .unwrap_or_else(|e| panic!("{} step {}: {e}", c.id, st.step));
         }

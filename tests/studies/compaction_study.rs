@@ -134,7 +134,7 @@ fn compaction_figure17_within_one_percent_of_fem_reference() {
     let completed: Vec<_> = r
         .sweep("fig17")
         .into_iter()
-        .filter(|c| c.method.name() == "igimp" && c.status == CaseStatus::Converged)
+        .filter(|c| c.method.name() == "igimp" && c.solve.status == CaseStatus::Converged)
         .collect();
     assert!(completed.len() >= 6);
     for c in &completed {
@@ -177,20 +177,32 @@ fn compaction_failures_are_recorded_with_step_and_residuals() {
     {
         let id = "igimp-vm12000-h0.25-p2-g0.03";
         let c = r.case(id).unwrap_or_else(|| panic!("case {id}"));
-        assert_eq!(c.status, CaseStatus::Failed, "{id}");
-        let f = c.failure.as_ref().unwrap();
+        assert_eq!(c.solve.status, CaseStatus::Failed, "{id}");
+        let f = c.solve.failure.as_ref().unwrap();
         assert!(
             f.step >= 1 && f.step <= 20 && !f.reason.is_empty() && !f.residuals.is_empty(),
             "{id}: {f:?}"
         );
-        assert_eq!(c.steps.len(), f.step - 1, "{id}");
+        assert_eq!(c.solve.steps.len(), f.step - 1, "{id}");
     }
     for c in r.sweep("fig17") {
-        assert_eq!(c.status, CaseStatus::Converged, "{}: {:?}", c.id, c.failure);
+        assert_eq!(
+            c.solve.status,
+            CaseStatus::Converged,
+            "{}: {:?}",
+            c.id,
+            c.solve.failure
+        );
     }
     assert!(r.case("igimp-elastic-h1-p1").is_some());
     for c in r.sweep("plastic") {
-        assert_eq!(c.status, CaseStatus::Converged, "{}: {:?}", c.id, c.failure);
+        assert_eq!(
+            c.solve.status,
+            CaseStatus::Converged,
+            "{}: {:?}",
+            c.id,
+            c.solve.failure
+        );
         assert!(c.max_horizontal_displacement.unwrap() > 5.0, "{}", c.id);
     }
 }
@@ -207,7 +219,13 @@ fn compaction_every_family_converges_to_the_q4_reference() {
         let cases = r.sweep(sweep);
         assert!(cases.len() >= 12, "{sweep}: {} cases", cases.len());
         for c in cases {
-            assert_eq!(c.status, CaseStatus::Converged, "{}: {:?}", c.id, c.failure);
+            assert_eq!(
+                c.solve.status,
+                CaseStatus::Converged,
+                "{}: {:?}",
+                c.id,
+                c.solve.failure
+            );
         }
     }
     let checks: Vec<_> = r.checks.iter().filter(|c| c.id.starts_with("families")).collect();

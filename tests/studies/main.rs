@@ -1,6 +1,7 @@
 //! The study harness end to end: study files, the tiers of every study, re-rendering byte
 //! for byte, resume, ParaView output and thread-count independence. One test binary.
 
+mod bar_study;
 mod cantilever_study;
 mod column3d_study;
 mod compaction_reference_study;

@@ -48,7 +48,7 @@ fn every_expected_3d_rate_is_inside_its_band() {
         );
     }
     for c in &r.cases {
-        assert_eq!(c.status, CaseStatus::Converged, "{}", c.id);
+        assert_eq!(c.solve.status, CaseStatus::Converged, "{}", c.id);
     }
 }
 

@@ -49,7 +49,7 @@ fn every_expected_rate_is_inside_its_band() {
         );
     }
     for c in r.cases.iter().filter(|c| c.method.is_fem()) {
-        assert_eq!(c.status, CaseStatus::Converged, "{}", c.id);
+        assert_eq!(c.solve.status, CaseStatus::Converged, "{}", c.id);
     }
 }
 

@@ -55,9 +55,9 @@ fn performance_fields_match_the_problem_size_and_add_up() {
     let r: CompactionResults = read_results(&tmp.path().join("compaction")).unwrap();
     let (w, ht) = (r.study.block.half_width, r.study.block.height);
     let mut q4 = 0;
-    for c in r.cases.iter().filter(|c| c.status == CaseStatus::Converged) {
-        assert!(!c.steps.is_empty(), "{}", c.id);
-        for s in &c.steps {
+    for c in r.cases.iter().filter(|c| c.solve.status == CaseStatus::Converged) {
+        assert!(!c.solve.steps.is_empty(), "{}", c.id);
+        for s in &c.solve.steps {
             match c.method {
                 Method::FEM_Q4 => {
                     let (n, nnz) = q4_compaction_size(w, ht, c.h);
@@ -121,14 +121,14 @@ fn performance_fields_match_the_problem_size_and_add_up() {
             k.seconds
         );
         assert_eq!(k.seconds, t.cases[&c.id], "{}", c.id);
-        if c.status == CaseStatus::Converged {
+        if c.solve.status == CaseStatus::Converged {
             assert!(
                 k.constitutive > 0.0 && k.assembly > 0.0 && k.setup > 0.0,
                 "{}: {k:?}",
                 c.id
             );
             // The tangent alone takes 16 bytes a non-zero (value and row index).
-            let nnz = c.steps.iter().map(|s| s.nonzeros).max().unwrap() as u64;
+            let nnz = c.solve.steps.iter().map(|s| s.nonzeros).max().unwrap() as u64;
             let heap = k.heap_peak_bytes.expect("the study binary counts the heap");
             assert!(heap >= 16 * nnz, "{}: heap peak {heap} B for nnz {nnz}", c.id);
             assert!(heap < 1 << 32, "{}: heap peak {heap} B for a quick case", c.id);

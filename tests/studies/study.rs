@@ -8,14 +8,14 @@ use igimp::method::Method;
 use igimp::render::column as report;
 use igimp::study::column::rates::RateRecord;
 use igimp::study::column::records::ColumnResults;
-use igimp::study::column::{Measure, StudySpec};
+use igimp::study::column::{ColumnStudy, Measure};
 use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
 use igimp::study::results::CaseStatus;
 use igimp::study::{StudyError, Tier};
 
-type StudyRun = Run<StudySpec>;
+type StudyRun = Run<ColumnStudy>;
 
-fn run_study(s: &StudySpec, file: &str, tier: Tier, _on_done: &dyn Fn(&str)) -> StudyRun {
+fn run_study(s: &ColumnStudy, file: &str, tier: Tier, _on_done: &dyn Fn(&str)) -> StudyRun {
     run_in_memory(s, file, tier).expect("an in-memory run")
 }
 
@@ -38,7 +38,7 @@ fn column_text() -> String {
 fn quick() -> &'static StudyRun {
     static RUN: OnceLock<StudyRun> = OnceLock::new();
     RUN.get_or_init(|| {
-        let spec = StudySpec::load(&column_file()).expect("column study parses");
+        let spec = ColumnStudy::load(&column_file()).expect("column study parses");
         run_study(&spec, "column.toml", Tier::Quick, &|_| {})
     })
 }
@@ -109,7 +109,13 @@ fn igimp_quick_tier_rates_inside_study_bands() {
     }
     // The iGIMP cases of the quick tier all converge.
     for c in run.results.cases.iter().filter(|c| c.method == Method::IGIMP) {
-        assert_eq!(c.status, CaseStatus::Converged, "{}: {:?}", c.id, c.failure);
+        assert_eq!(
+            c.solve.status,
+            CaseStatus::Converged,
+            "{}: {:?}",
+            c.id,
+            c.solve.failure
+        );
     }
 }
 
@@ -160,7 +166,7 @@ fn igimp_stress_error_below_linear_fem_at_equal_elements() {
 #[test]
 fn study_runs_are_repeatable_and_results_json_parses() {
     let first = quick();
-    let spec = StudySpec::load(&column_file()).unwrap();
+    let spec = ColumnStudy::load(&column_file()).unwrap();
     let second = run_study(&spec, "column.toml", Tier::Quick, &|_| {});
     assert_eq!(first.results.without_timing(), second.results.without_timing());
     assert_eq!(first.outputs, second.outputs);
@@ -187,7 +193,7 @@ fn study_runs_are_repeatable_and_results_json_parses() {
         "results.json differs beyond wall-clock fields"
     );
     for case in &ra.cases {
-        if case.status != CaseStatus::Rejected {
+        if case.solve.status != CaseStatus::Rejected {
             let csv = std::fs::read_to_string(a.join(format!("points/{}.csv", case.id))).unwrap();
             assert!(csv.starts_with("z0,z,volume0,sigma_zz,f_zz\n"));
             assert_eq!(csv.lines().count(), case.points + 1);
@@ -294,7 +300,7 @@ fn study_binary_help_and_list_name_the_column_study() {
 }
 
 fn parse_err(text: &str) -> String {
-    match StudySpec::parse(text, "bad.toml") {
+    match ColumnStudy::parse(text, "bad.toml") {
         Ok(_) => panic!("study file accepted"),
         Err(e) => e.to_string(),
     }
@@ -314,7 +320,7 @@ fn study_file_with_misspelt_key_is_rejected_naming_it() {
 #[test]
 fn study_file_with_negative_element_count_names_key_and_range() {
     let text = column_text().replacen("elements = [50]", "elements = [-50]", 1);
-    let err = StudySpec::parse(&text, "bad.toml").unwrap_err();
+    let err = ColumnStudy::parse(&text, "bad.toml").unwrap_err();
     match &err {
         StudyError::Invalid { key, allowed, .. } => {
             assert_eq!(key, "sweeps[0].elements[0]");
@@ -397,19 +403,19 @@ sweep = "fine"
 weight = 40000.0
 measure = "stress_error"
 "#;
-    let spec = StudySpec::parse(text, "diverge.toml").unwrap();
+    let spec = ColumnStudy::parse(text, "diverge.toml").unwrap();
     let run = run_study(&spec, "diverge.toml", Tier::Full, &|_| {});
     let cases = &run.results.cases;
     assert_eq!(cases.len(), 3);
     let failed = &cases[0];
-    assert_eq!(failed.status, CaseStatus::Failed, "{failed:?}");
+    assert_eq!(failed.solve.status, CaseStatus::Failed, "{failed:?}");
     assert!(failed.id.contains("it1"), "{}", failed.id);
-    let f = failed.failure.as_ref().unwrap();
+    let f = failed.solve.failure.as_ref().unwrap();
     assert_eq!(f.step, 1);
     assert!(!f.residuals.is_empty(), "{f:?}");
     assert_eq!(failed.stress_error, None);
     for c in &cases[1..] {
-        assert_eq!(c.status, CaseStatus::Converged, "{c:?}");
+        assert_eq!(c.solve.status, CaseStatus::Converged, "{c:?}");
         assert!(c.stress_error.is_some_and(|e| e > 0.0 && e < 0.1));
     }
     // The failure is in results.json and the report, and rendering still works.
@@ -427,7 +433,7 @@ measure = "stress_error"
 #[test]
 fn plastic_column_quick_tier_meets_its_bands_and_yield_height() {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/column-plastic.toml");
-    let spec = StudySpec::load(&file).expect("plastic study parses");
+    let spec = ColumnStudy::load(&file).expect("plastic study parses");
     let run = run_study(&spec, "column-plastic.toml", Tier::Quick, &|_| {});
     let expected: Vec<&RateRecord> = run
         .results

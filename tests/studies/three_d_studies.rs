@@ -60,14 +60,14 @@ fn compaction_3d_quick_tier_converges_quadratically_and_passes_its_checks() {
         r.cases
             .iter()
             .filter(|c| c.yield_stress.is_none())
-            .map(|c| (c.id.as_str(), c.status, &c.steps[..])),
+            .map(|c| (c.id.as_str(), c.solve.status, &c.solve.steps[..])),
         ELASTIC,
     );
     assert_converged_quadratically(
         r.cases
             .iter()
             .filter(|c| c.yield_stress.is_some())
-            .map(|c| (c.id.as_str(), c.status, &c.steps[..])),
+            .map(|c| (c.id.as_str(), c.solve.status, &c.solve.steps[..])),
         PLASTIC,
     );
     // The families sweep is full tier only: its checks are not evaluated here.
@@ -134,12 +134,12 @@ fn cantilever_3d_quick_tier_completes_beside_the_elastica_and_hex20() {
     // at 4.8e-9, reference/README.md item 24). Below 1e-4, r_{k+1} ≤ 100 r_k²: a linear
     // rate would need r_{k+1} ≥ 1e-2 r_k there, which this excludes below 1e-4.
     // The F-diagonal update (eq 37) is meant to collapse (its check below); the rest converge.
-    assert_eq!(r.case("f-diagonal").unwrap().status, CaseStatus::Failed);
+    assert_eq!(r.case("f-diagonal").unwrap().solve.status, CaseStatus::Failed);
     assert_converged_quadratically(
         r.cases
             .iter()
             .filter(|c| c.id != "f-diagonal")
-            .map(|c| (c.id.as_str(), c.status, &c.steps[..])),
+            .map(|c| (c.id.as_str(), c.solve.status, &c.solve.steps[..])),
         (1e-4, 1e-8, 100.0),
     );
     // The ghost sensitivity (full tier only: 0.51 % at h = 0.5, shown; 0.17 % at h = 0.25,

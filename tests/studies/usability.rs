@@ -542,7 +542,10 @@ print(json.dumps({"type": m.cells[0].type, "n": len(m.cells[0].data),
 }
 
 /// `--shard K/N` then `--merge` gives the results.json of an unsharded run (timing aside) for
-/// a column and a plane-strain study; shards write no results.json; `--merge` with a shard
+/// a column and a plane-strain study (the compaction's quick tier cut to Figure 17 at h = 1,
+/// 1/2 with 2x2 points and its FEM reference sweep: the subject is the store and the merge,
+/// not the numbers; the whole quick tier ran twice here, 74 s of the suite); shards write no
+/// results.json; `--merge` with a shard
 /// missing fails naming the cases no shard stored.
 #[test]
 fn sharded_runs_merge_to_the_unsharded_results() {
@@ -550,7 +553,28 @@ fn sharded_runs_merge_to_the_unsharded_results() {
     let tmp = tempfile::tempdir().unwrap();
     write_study(tmp.path(), "tiny", TINY);
     let studies = tmp.path().join("studies");
-    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies");
+    let repo = crate::trimmed::write(
+        &tmp.path().join("cut"),
+        "compaction",
+        &[
+            "plastic",
+            "plastic-ghost",
+            "ghost",
+            "weak-nodes",
+            "families",
+            "families-ghost",
+        ],
+    );
+    // Figure 17's sweep (the reference names it) at h = 1 and 1/2 with 2x2 points only.
+    let cut = repo.join("compaction.toml");
+    let mut doc: toml::Table = std::fs::read_to_string(&cut).unwrap().parse().unwrap();
+    let sweeps = doc["sweeps"].as_array_mut().unwrap();
+    let fig17 = sweeps
+        .iter_mut()
+        .find(|t| t["id"].as_str() == Some("fig17"))
+        .unwrap();
+    fig17["quick"] = toml::toml! { element_sizes = [1.0, 0.5] points_per_cell = [2] }.into();
+    std::fs::write(&cut, toml::to_string(&doc).unwrap()).unwrap();
     let n = 3;
     for k in 0..n {
         let shard = format!("{k}/{n}");

@@ -9,7 +9,7 @@ use igimp::newton::NewtonSettings;
 use igimp::problems::cantilever::CantileverSpec;
 use igimp::problems::column::{solve_column, ColumnSpec, Method};
 use igimp::problems::compaction::CompactionSpec;
-use igimp::study::column::StudySpec;
+use igimp::study::column::ColumnStudy;
 use igimp::study::engine::StudyKind;
 use igimp::study::store::confined;
 use igimp::study::{StudyError, Tier};
@@ -85,14 +85,14 @@ const FIELDS: &[&str] = &[
 ];
 
 /// Parse in `catch_unwind`; a panic fails the property with the input.
-fn parse(text: &str) -> Result<Result<StudySpec, StudyError>, TestCaseError> {
-    catch_unwind(AssertUnwindSafe(|| StudySpec::parse(text, "hostile.toml")))
-        .map_err(|_| TestCaseError::fail(format!("StudySpec::parse panicked on:\n{text}")))
+fn parse(text: &str) -> Result<Result<ColumnStudy, StudyError>, TestCaseError> {
+    catch_unwind(AssertUnwindSafe(|| ColumnStudy::parse(text, "hostile.toml")))
+        .map_err(|_| TestCaseError::fail(format!("ColumnStudy::parse panicked on:\n{text}")))
 }
 
 /// A parsed study is usable: every case of both tiers is a valid column, and every id is a
 /// plain file name inside the output folder.
-fn check_accepted(spec: &StudySpec) -> Result<(), TestCaseError> {
+fn check_accepted(spec: &ColumnStudy) -> Result<(), TestCaseError> {
     confined(Path::new("out"), &spec.name).map_err(|e| TestCaseError::fail(e.to_string()))?;
     for tier in [Tier::Quick, Tier::Full] {
         for case in spec.cases(tier) {
@@ -603,7 +603,7 @@ fn huge_counts_are_rejected_before_allocating() {
             &format!("elements = [{}]", elements.join(", ")),
             1,
         );
-    let e = StudySpec::parse(&text, "hostile.toml").unwrap_err().to_string();
+    let e = ColumnStudy::parse(&text, "hostile.toml").unwrap_err().to_string();
     assert!(e.contains("sweeps[0]"), "{e}");
 }
 
@@ -732,7 +732,7 @@ fn hostile_inputs_table() {
             _ => unreachable!("{key}"),
         }
         let text = toml::to_string(&doc).unwrap();
-        let e = StudySpec::parse(&text, "hostile.toml")
+        let e = ColumnStudy::parse(&text, "hostile.toml")
             .expect_err(what)
             .to_string();
         let leaf = last_key(&path);
@@ -740,7 +740,7 @@ fn hostile_inputs_table() {
         print(what, key, &e);
     }
     let unknown = study_text("column").replacen("[newton]", "[newton]\ntolerence = 1e-9", 1);
-    let e = StudySpec::parse(&unknown, "hostile.toml")
+    let e = ColumnStudy::parse(&unknown, "hostile.toml")
         .unwrap_err()
         .to_string();
     assert!(e.contains("tolerence"), "{e}");

@@ -12,6 +12,7 @@ mod custom_basis;
 mod basis;
 mod column;
 mod compaction;
+mod dynamics;
 mod elastica;
 mod families;
 mod fem;

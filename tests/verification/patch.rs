@@ -31,6 +31,7 @@ fn patch<const D: usize>(
         volume_update: Default::default(),
         linear_solver: Default::default(),
         ghost: Default::default(),
+        dynamics: None,
     };
     let loads = Loads {
         gravity: SVector::<f64, D>::zeros(),
@@ -66,6 +67,7 @@ fn patch<const D: usize>(
         ghost: None,
         fixed_forces: &mut Vec::new(),
         linearised: None,
+        inertia: None,
     };
     let mut r = vec![0.0; dofs.len()];
     sys.evaluate(&u, &mut r).unwrap();

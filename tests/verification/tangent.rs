@@ -129,6 +129,7 @@ fn tangent_error_with<const D: usize>(
         ghost: ghost.as_ref(),
         fixed_forces: &mut Vec::new(),
         linearised: None,
+        inertia: None,
     };
     let mut r0 = vec![0.0; n];
     sys.evaluate(&u0, &mut r0).unwrap();
@@ -247,6 +248,7 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
             volume_update: Default::default(),
             linear_solver: Default::default(),
             ghost,
+            dynamics: None,
         };
         let loads = Loads {
             gravity: SVector::<f64, 2>::zeros(),
@@ -374,6 +376,7 @@ fn gimp_3d_global_tangent_matches_central_differences_rotated_stretched_plastic_
             volume_update: Default::default(),
             linear_solver: Default::default(),
             ghost: Default::default(),
+            dynamics: None,
         };
         let loads = Loads {
             gravity: SVector::<f64, 3>::zeros(),

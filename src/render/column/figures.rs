@@ -20,7 +20,7 @@ pub fn render_figure(
             let mut series_out = vec![];
             for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {
                 for c in series(&results.cases, ids, m, fig.weight, ppc) {
-                    if c.status != CaseStatus::Converged {
+                    if c.solve.status != CaseStatus::Converged {
                         continue;
                     }
                     let rows = read_points_csv(&study_dir.join(points_file(&c.id)))?;
@@ -40,7 +40,7 @@ pub fn render_figure(
                 // The lateral stress is recorded in the sixth column of plastic point files.
                 for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {
                     for c in series(&results.cases, ids, m, fig.weight, ppc) {
-                        if c.status != CaseStatus::Converged {
+                        if c.solve.status != CaseStatus::Converged {
                             continue;
                         }
                         let rows = read_points_csv(&study_dir.join(points_file(&c.id)))?;

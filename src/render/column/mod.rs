@@ -12,7 +12,7 @@ use super::IndexEntry;
 use crate::method::Method;
 use crate::study::column::kind::{points_file, read_points_csv};
 use crate::study::column::rates::{case_error, pairwise_rates, series};
-use crate::study::column::records::{AnalyticalRecord, CaseRecord, ColumnResults};
+use crate::study::column::records::{AnalyticalRecord, ColumnRecord, ColumnResults};
 use crate::study::column::{FigureKind, FigureSpec, Measure};
 use crate::study::results::{read_results, CaseStatus};
 use crate::study::vocabulary::weight_label;
@@ -35,8 +35,8 @@ pub(super) fn rate(x: Option<f64>) -> String {
     x.map_or("—".into(), |v| format!("{v:.2}"))
 }
 
-pub(super) fn status_word(c: &CaseRecord) -> &'static str {
-    c.status.word()
+pub(super) fn status_word(c: &ColumnRecord) -> &'static str {
+    c.solve.status.word()
 }
 
 /// The case ids of a sweep as the run recorded them.

@@ -13,9 +13,9 @@ pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::render::NotD
     let _ = writeln!(
         s,
         "Checks: {pass} passed, {fail} failed, {none} not evaluated. Cases: {} converged, {} failed, {} rejected.\n",
-        results.cases.iter().filter(|c| c.status == CaseStatus::Converged).count(),
-        results.cases.iter().filter(|c| c.status == CaseStatus::Failed).count(),
-        results.cases.iter().filter(|c| c.status == CaseStatus::Rejected).count(),
+        results.cases.iter().filter(|c| c.solve.status == CaseStatus::Converged).count(),
+        results.cases.iter().filter(|c| c.solve.status == CaseStatus::Failed).count(),
+        results.cases.iter().filter(|c| c.solve.status == CaseStatus::Rejected).count(),
     );
 
     for p in &spec.paper {
@@ -45,13 +45,13 @@ pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::render::NotD
             exact.top_displacement, f0, p.analytical_base_f, p.analytical_base_f, p.analytical_base_f
         );
         let ids = of_sweep(results, &p.sweep);
-        let cases: Vec<Option<&CaseRecord>> = p
+        let cases: Vec<Option<&ColumnRecord>> = p
             .elements
             .iter()
             .map(|&n| {
                 series(&results.cases, ids, p.method, p.weight, ppc)
                     .into_iter()
-                    .find(|c| c.elements == n as usize && c.status == CaseStatus::Converged)
+                    .find(|c| c.elements == n as usize && c.solve.status == CaseStatus::Converged)
             })
             .collect();
         let _ = write!(s, "| number of elements |");
@@ -63,7 +63,7 @@ pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::render::NotD
             let _ = write!(s, "---:|");
         }
         s.push('\n');
-        let mut row = |name: &str, f: &dyn Fn(usize, Option<&CaseRecord>) -> String| {
+        let mut row = |name: &str, f: &dyn Fn(usize, Option<&ColumnRecord>) -> String| {
             let _ = write!(s, "| {name} |");
             for (i, c) in cases.iter().enumerate() {
                 let _ = write!(s, " {} |", f(i, *c));
@@ -206,10 +206,13 @@ pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::render::NotD
                     pairwise_rates(&n, &ex),
                 );
                 for (i, c) in cs.iter().enumerate() {
-                    let its = if c.steps.is_empty() {
+                    let its = if c.solve.steps.is_empty() {
                         "—".to_string()
                     } else {
-                        format!("{:.2}", c.newton_iterations as f64 / c.steps.len() as f64)
+                        format!(
+                            "{:.2}",
+                            c.solve.newton_iterations as f64 / c.solve.steps.len() as f64
+                        )
                     };
                     let extra = if plastic {
                         format!(
@@ -314,17 +317,17 @@ pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::render::NotD
         }
         s.push('\n');
     }
-    let bad: Vec<&CaseRecord> = results
+    let bad: Vec<&ColumnRecord> = results
         .cases
         .iter()
-        .filter(|c| c.status != CaseStatus::Converged)
+        .filter(|c| c.solve.status != CaseStatus::Converged)
         .collect();
     if !bad.is_empty() {
         let _ = writeln!(s, "## Cases that did not converge\n");
         let _ = writeln!(s, "| case | status | step | reason |");
         let _ = writeln!(s, "|---|---|---:|---|");
         for c in bad {
-            let f = c.failure.as_ref();
+            let f = c.solve.failure.as_ref();
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} |",

@@ -20,7 +20,7 @@ pub(super) fn compute_checks(results: &CantileverResults) -> Vec<CheckRecord> {
             format!(
                 "load steps not completed by `{}` (status {})",
                 e.case,
-                c.map_or("not run", |c| c.status.word())
+                c.map_or("not run", |c| c.solve.status.word())
             ),
             c.map(|c| (c.load_steps - c.end.len()) as f64),
             0.0,
@@ -55,8 +55,9 @@ pub(super) fn compute_checks(results: &CantileverResults) -> Vec<CheckRecord> {
         let rstatus = results.case(&e.reference).map_or("not run".to_string(), |c| {
             format!(
                 "{}{}",
-                c.status.word(),
-                c.failure
+                c.solve.status.word(),
+                c.solve
+                    .failure
                     .as_ref()
                     .map_or(String::new(), |f| format!(": {}", f.reason))
             )
@@ -80,8 +81,9 @@ pub(super) fn compute_checks(results: &CantileverResults) -> Vec<CheckRecord> {
                 // The failing step's residuals are empty when the failure comes before its
                 // first Newton solve (a collapsed domain cannot be evaluated); the converged
                 // steps' histories are in `steps`.
-                let failed_part_way = c.status == CaseStatus::Failed
-                    && c.failure
+                let failed_part_way = c.solve.status == CaseStatus::Failed
+                    && c.solve
+                        .failure
                         .as_ref()
                         .is_some_and(|f| f.step > 1 && f.step <= c.load_steps && !f.reason.is_empty());
                 let m = &c.min_half_length;
@@ -93,8 +95,8 @@ pub(super) fn compute_checks(results: &CantileverResults) -> Vec<CheckRecord> {
                     ratio.map(|r| failed_part_way && shrinking && r < e.fraction),
                     format!(
                         "failed part-way with step and reason recorded: {failed_part_way} (step {}, {} residuals of the failing step); smallest half-length non-increasing over the last {w} converged steps: {shrinking}",
-                        c.failure.as_ref().map_or(0, |f| f.step),
-                        c.failure.as_ref().map_or(0, |f| f.residuals.len())
+                        c.solve.failure.as_ref().map_or(0, |f| f.step),
+                        c.solve.failure.as_ref().map_or(0, |f| f.residuals.len())
                     ),
                 )
             }

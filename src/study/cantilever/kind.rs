@@ -73,8 +73,7 @@ fn solve_case_snapshots(
         load: s.load,
         element_size: s.element_size,
         load_steps: s.load_steps,
-        status: solved.status,
-        failure: solved.failure,
+        solve: solved,
         end,
         u_over_l: u,
         v_over_l: v,
@@ -84,8 +83,6 @@ fn solve_case_snapshots(
         initial_half_length: 0.5 * s.element_size / s.points_per_cell as f64,
         min_half_length,
         loaded_points,
-        newton_iterations: solved.newton_iterations,
-        steps: solved.steps,
     };
     // Keep one snapshot per step (a failing step repeats the last converged state).
     snaps.dedup_by_key(|s| s.step);
@@ -180,10 +177,7 @@ fn write_case_vtk(
                 domains: s
                     .domains
                     .iter()
-                    .map(|d| DomainBox {
-                        centre: [d[0], d[1], d[2]],
-                        half: [d[3], d[4], d[5]],
-                    })
+                    .map(|d| DomainBox::new([d[0], d[1], d[2]], [d[3], d[4], d[5]]))
                     .collect(),
                 scalars: vec![],
             })

@@ -5,7 +5,7 @@ use super::CantileverStudy;
 use crate::method::Method;
 use crate::mpm::{DomainUpdate, VolumeUpdate};
 use crate::problems::cantilever::EndDisplacement;
-use crate::study::results::{case_record, CaseStatus, Envelope, FailureRecord, StepRecord};
+use crate::study::results::{case_record, Envelope, SolveRecord};
 use serde::{Deserialize, Serialize};
 
 /// The elastica at one load: the end displacement in the model's axes.
@@ -38,8 +38,9 @@ pub struct CantileverRecord {
     pub load: f64,
     pub element_size: f64,
     pub load_steps: usize,
-    pub status: CaseStatus,
-    pub failure: Option<FailureRecord>,
+    /// Status, failure, Newton iterations and residual histories (flattened into the record).
+    #[serde(flatten)]
+    pub solve: SolveRecord,
     /// End displacement (mean of the loaded points; FEM: the loaded node) after each converged step.
     pub end: Vec<EndDisplacement>,
     /// Final u/L and v/L (converged cases only).
@@ -55,8 +56,6 @@ pub struct CantileverRecord {
     pub min_half_length: Vec<f64>,
     /// Indices of the loaded points in the domain snapshots (3D: those in the snapshot's layer).
     pub loaded_points: Option<Vec<usize>>,
-    pub newton_iterations: usize,
-    pub steps: Vec<StepRecord>,
 }
 
 /// One row of the depth study.

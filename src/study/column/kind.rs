@@ -8,17 +8,15 @@
 //! rejects as input is `"rejected"`.
 
 use super::rates::{compute_comparisons, compute_rates};
-use super::records::{AnalyticalRecord, CaseRecord, POINTS_HEADER, POINTS_HEADER_PLASTIC, PROFILE_SAMPLES};
-use super::{Case, StudySpec};
-use crate::method::Method;
+use super::records::{AnalyticalRecord, ColumnRecord, POINTS_HEADER, POINTS_HEADER_PLASTIC, PROFILE_SAMPLES};
+use super::{ColumnCase, ColumnStudy};
 use crate::problems::column::{solve_column_observed, ColumnObserver, ColumnSpec, PointRecord};
 use crate::study::checks::{check_rate, CheckRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{fresh_points_dir, CaseStatus, SolveRecord, SweepIndex};
-use crate::study::store::{case_hash, confined, write_file};
+use crate::study::store::{confined, write_file};
 use crate::study::vtk_output::ColumnVtkWriter;
 use crate::study::{StudyError, Tier};
-use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 fn finite(x: f64) -> Option<f64> {
@@ -26,13 +24,16 @@ fn finite(x: f64) -> Option<f64> {
 }
 
 /// Solve one case.
-pub fn run_case(case: &Case) -> (CaseRecord, Vec<PointRecord>) {
+pub fn run_case(case: &ColumnCase) -> (ColumnRecord, Vec<PointRecord>) {
     run_case_observed(case, &mut |_, _| {})
 }
 
 /// [`run_case`], showing the solver to `observer` before the first and after every converged
 /// load step.
-pub fn run_case_observed(case: &Case, observer: &mut ColumnObserver<'_>) -> (CaseRecord, Vec<PointRecord>) {
+pub fn run_case_observed(
+    case: &ColumnCase,
+    observer: &mut ColumnObserver<'_>,
+) -> (ColumnRecord, Vec<PointRecord>) {
     let (solved, out) = match solve_column_observed(&case.spec, case.method, observer) {
         Err(e) => (SolveRecord::rejected(e), None),
         Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
@@ -42,7 +43,7 @@ pub fn run_case_observed(case: &Case, observer: &mut ColumnObserver<'_>) -> (Cas
     let plastic = conv.filter(|_| case.spec.yield_stress.is_some());
     let yield_height = plastic.and_then(|o| o.yield_height);
     let exact_yield = case.spec.analytical().yield_height();
-    let rec = CaseRecord {
+    let rec = ColumnRecord {
         id: case.id.clone(),
         method: case.method,
         load: case.spec.weight,
@@ -50,8 +51,7 @@ pub fn run_case_observed(case: &Case, observer: &mut ColumnObserver<'_>) -> (Cas
         points_per_cell: case.points_per_cell,
         load_steps: case.spec.load_steps,
         newton: case.spec.newton,
-        status: solved.status,
-        failure: solved.failure,
+        solve: solved,
         stress_error: conv.and_then(|o| finite(o.stress_error)),
         f_error: conv.and_then(|o| finite(o.f_error)),
         sigma_xx_error: plastic.and_then(|o| finite(o.sigma_xx_error)),
@@ -63,62 +63,33 @@ pub fn run_case_observed(case: &Case, observer: &mut ColumnObserver<'_>) -> (Cas
         top_displacement: conv.and_then(|o| finite(o.top_displacement)),
         base_f: conv.and_then(|o| finite(o.base_f)),
         points: out.as_ref().map_or(0, |o| o.points.len()),
-        newton_iterations: solved.newton_iterations,
-        steps: solved.steps,
     };
     (rec, out.map_or(vec![], |o| o.points))
 }
 
-/// What the case store keeps of a finished column case.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ColumnOutput {
-    pub record: CaseRecord,
-    pub points: Vec<PointRecord>,
-}
-
-/// The inputs that determine a case's results.
-#[derive(Serialize)]
-struct CaseDefinition<'a> {
-    id: &'a str,
-    method: Method,
-    points_per_cell: Option<usize>,
-    spec: &'a ColumnSpec,
-}
-
-/// Stable hash of a case's inputs (id, method, points per cell and the full [`ColumnSpec`]),
-/// [`case_hash`] of their canonical JSON.
-pub fn case_definition_hash(case: &Case) -> String {
-    case_hash(&CaseDefinition {
-        id: &case.id,
-        method: case.method,
-        points_per_cell: case.points_per_cell,
-        spec: &case.spec,
-    })
-}
-
-impl StudyKind for StudySpec {
+impl StudyKind for ColumnStudy {
     const PROBLEM: &'static str = "column";
-    type Case = Case;
-    type Output = ColumnOutput;
-    type Record = CaseRecord;
+    type Case = ColumnCase;
+    type Output = (ColumnRecord, Vec<PointRecord>);
+    type Record = ColumnRecord;
     type Measures = super::records::ColumnMeasures;
 
     study_file_fields!();
-    fn cases(&self, tier: Tier) -> (Vec<Case>, SweepIndex) {
+    fn cases(&self, tier: Tier) -> (Vec<ColumnCase>, SweepIndex) {
         (self.cases(tier), self.case_index(tier))
     }
-    fn key(&self, case: &Case) -> CaseKey {
+    fn key(&self, case: &ColumnCase) -> CaseKey {
+        // FEM columns write ParaView files too (their Gauss points, ColumnVtkWriter).
         CaseKey {
-            id: case.id.clone(),
-            hash: case_definition_hash(case),
             has_vtk: true,
+            ..CaseKey::of_spec(&case.id, case.method, &case.spec, 0)
         }
     }
-    fn cost(&self, c: &Case) -> f64 {
+    fn cost(&self, c: &ColumnCase) -> f64 {
         (c.spec.elements * c.points_per_cell.unwrap_or(3) * c.spec.load_steps) as f64
     }
-    fn solve(&self, case: &Case, vtk: Option<&VtkTarget>) -> Result<ColumnOutput, StudyError> {
-        let (record, points) = match vtk {
+    fn solve(&self, case: &ColumnCase, vtk: Option<&VtkTarget>) -> Result<Self::Output, StudyError> {
+        Ok(match vtk {
             None => run_case(case),
             Some(v) => {
                 let mut w = ColumnVtkWriter::new(&v.study_dir, &case.id, case.spec.load_steps, v.options)?;
@@ -126,11 +97,10 @@ impl StudyKind for StudySpec {
                 w.finish()?;
                 out
             }
-        };
-        Ok(ColumnOutput { record, points })
+        })
     }
-    fn record(o: &ColumnOutput) -> &CaseRecord {
-        &o.record
+    fn record(o: &Self::Output) -> &ColumnRecord {
+        &o.0
     }
     fn measure(results: &mut Results<Self>) {
         let (spec, tier) = (&results.study, results.provenance.tier);
@@ -141,12 +111,15 @@ impl StudyKind for StudySpec {
         results.checks = column_checks(m);
     }
     /// `points/<case>.csv` of every case that was solved (stale point files removed).
-    fn write_side_files(&self, dir: &Path, outputs: &[ColumnOutput]) -> Result<(), StudyError> {
+    fn write_side_files(&self, dir: &Path, outputs: &[Self::Output]) -> Result<(), StudyError> {
         let pdir = fresh_points_dir(dir)?;
         let plastic = self.column.yield_stress.is_some();
-        for o in outputs.iter().filter(|o| o.record.status != CaseStatus::Rejected) {
-            let p = confined(&pdir, &format!("{}.csv", o.record.id))?;
-            write_file(&p, points_csv(&o.points, plastic).as_bytes())?;
+        for (record, points) in outputs
+            .iter()
+            .filter(|o| o.0.solve.status != CaseStatus::Rejected)
+        {
+            let p = confined(&pdir, &format!("{}.csv", record.id))?;
+            write_file(&p, points_csv(points, plastic).as_bytes())?;
         }
         Ok(())
     }
@@ -204,7 +177,7 @@ fn column_checks(m: &super::records::ColumnMeasures) -> Vec<CheckRecord> {
 }
 
 /// The analytical column at every load of the cases, paper tables and figures.
-fn analytical_records(spec: &StudySpec, cases: &[CaseRecord]) -> Vec<AnalyticalRecord> {
+fn analytical_records(spec: &ColumnStudy, cases: &[ColumnRecord]) -> Vec<AnalyticalRecord> {
     let mut loads: Vec<f64> = cases
         .iter()
         .map(|c| c.load)

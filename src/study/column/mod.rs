@@ -223,7 +223,7 @@ pub struct FigureSpec {
 /// A study file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct StudySpec {
+pub struct ColumnStudy {
     /// Layout version; must equal [`SCHEMA_VERSION`](crate::study::SCHEMA_VERSION).
     pub schema: i64,
     /// Name of the study and of its output folder (see [`ident_ok`](crate::study::vocabulary::ident_ok)).
@@ -274,7 +274,7 @@ pub struct ColumnGhost {
 
 /// One case to solve.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Case {
+pub struct ColumnCase {
     /// Unique and file-name safe, e.g. `igimp-w400000-e256-p2-s20`.
     pub id: String,
     pub method: Method,
@@ -296,7 +296,7 @@ pub struct SweepPlan {
     pub untreated: bool,
 }
 
-impl StudySpec {
+impl ColumnStudy {
     pub fn sweep(&self, id: &str) -> Option<&Sweep> {
         self.sweeps.iter().find(|s| s.id == id)
     }
@@ -381,7 +381,7 @@ impl StudySpec {
     }
 
     /// The cases of one sweep in order method, weight, points per cell, elements.
-    pub fn sweep_cases(&self, plan: &SweepPlan) -> Vec<Case> {
+    pub fn sweep_cases(&self, plan: &SweepPlan) -> Vec<ColumnCase> {
         let mut out = Vec::new();
         for &method in &plan.methods {
             let ppcs: Vec<Option<usize>> = if method.uses_material_points() {
@@ -398,7 +398,7 @@ impl StudySpec {
                             ppc.unwrap_or(ColumnSpec::default().points_per_cell),
                             plan,
                         );
-                        out.push(Case {
+                        out.push(ColumnCase {
                             id: self.case_id(method, ppc, &spec),
                             method,
                             points_per_cell: ppc,
@@ -413,7 +413,7 @@ impl StudySpec {
 
     /// Every distinct case of the tier, in file order; a case shared by two sweeps appears
     /// once.
-    pub fn cases(&self, tier: Tier) -> Vec<Case> {
+    pub fn cases(&self, tier: Tier) -> Vec<ColumnCase> {
         let mut seen = BTreeSet::new();
         self.sweeps
             .iter()

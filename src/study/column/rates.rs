@@ -5,17 +5,17 @@
 //! one series (method, weight, points per cell). Pairwise log2 rates per refinement are
 //! computed by [`pairwise_rates`] for the tables.
 
-use super::records::CaseRecord;
+use super::records::ColumnRecord;
 pub use super::records::{ComparisonRecord, ExpectedBand, RateRecord};
-use super::{Measure, StudySpec};
+use super::{ColumnStudy, Measure};
 use crate::method::Method;
 use crate::study::checks::fitted_rate_finest;
 use crate::study::results::{CaseStatus, SweepIndex};
 use crate::study::Tier;
 
 /// The error of a case under a measure (converged cases only).
-pub fn case_error(case: &CaseRecord, measure: Measure) -> Option<f64> {
-    if case.status != CaseStatus::Converged {
+pub fn case_error(case: &ColumnRecord, measure: Measure) -> Option<f64> {
+    if case.solve.status != CaseStatus::Converged {
         return None;
     }
     let e = match measure {
@@ -29,13 +29,13 @@ pub fn case_error(case: &CaseRecord, measure: Measure) -> Option<f64> {
 
 /// The converged cases of one series, sorted by element count.
 pub fn series<'a>(
-    cases: &'a [CaseRecord],
+    cases: &'a [ColumnRecord],
     ids: &[String],
     method: Method,
     load: f64,
     ppc: Option<usize>,
-) -> Vec<&'a CaseRecord> {
-    let mut v: Vec<&CaseRecord> = cases
+) -> Vec<&'a ColumnRecord> {
+    let mut v: Vec<&ColumnRecord> = cases
         .iter()
         .filter(|c| ids.contains(&c.id))
         .filter(|c| c.method == method && c.load == load && c.points_per_cell == ppc)
@@ -61,9 +61,9 @@ pub fn pairwise_rates(elements: &[usize], errors: &[Option<f64>]) -> Vec<Option<
 /// Fit every series of every sweep with two or more element counts, then attach the
 /// expectations of the study file.
 pub fn compute_rates(
-    spec: &StudySpec,
+    spec: &ColumnStudy,
     tier: Tier,
-    cases: &[CaseRecord],
+    cases: &[ColumnRecord],
     case_ids: &SweepIndex,
 ) -> Vec<RateRecord> {
     let mut out = Vec::new();
@@ -151,9 +151,9 @@ pub fn compute_rates(
 
 /// Evaluate the `[[compare]]` checks.
 pub fn compute_comparisons(
-    spec: &StudySpec,
+    spec: &ColumnStudy,
     tier: Tier,
-    cases: &[CaseRecord],
+    cases: &[ColumnRecord],
     case_ids: &SweepIndex,
 ) -> Vec<ComparisonRecord> {
     spec.compare
@@ -165,7 +165,7 @@ pub fn compute_comparisons(
             let mut ratios = vec![];
             if let Some(plan) = spec.plan(sweep, tier) {
                 let ids = case_ids.get(&sweep.id).map_or(&[][..], |v| v.as_slice());
-                let pick = |m: Method| -> Vec<&CaseRecord> {
+                let pick = |m: Method| -> Vec<&ColumnRecord> {
                     let ppcs: Vec<Option<usize>> = if m.uses_material_points() {
                         plan.points_per_cell.iter().map(|&p| Some(p)).collect()
                     } else {

@@ -2,10 +2,10 @@
 //! fitted rates and comparisons and the analytical column. The kind fills it, the renderer
 //! reads it only.
 
-use super::{Measure, StudySpec};
+use super::{ColumnStudy, Measure};
 use crate::method::Method;
 use crate::newton::NewtonSettings;
-use crate::study::results::{case_record, CaseStatus, Envelope, FailureRecord, StepRecord};
+use crate::study::results::{case_record, Envelope, SolveRecord};
 use serde::{Deserialize, Serialize};
 
 /// Header of the per-case point files.
@@ -15,7 +15,7 @@ pub const POINTS_HEADER_PLASTIC: &str = "z0,z,volume0,sigma_zz,f_zz,sigma_xx";
 
 /// Result of one case.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CaseRecord {
+pub struct ColumnRecord {
     pub id: String,
     pub method: Method,
     /// Total weight W.
@@ -25,8 +25,9 @@ pub struct CaseRecord {
     pub points_per_cell: Option<usize>,
     pub load_steps: usize,
     pub newton: NewtonSettings,
-    pub status: CaseStatus,
-    pub failure: Option<FailureRecord>,
+    /// Status, failure, Newton iterations and residual histories (flattened into the record).
+    #[serde(flatten)]
+    pub solve: SolveRecord,
     /// Eq (46), converged cases only.
     pub stress_error: Option<f64>,
     /// Eq (47) against the exact analytical base F, converged cases only.
@@ -44,12 +45,9 @@ pub struct CaseRecord {
     pub base_f: Option<f64>,
     /// Number of material or Gauss points (rows of the point file).
     pub points: usize,
-    /// Newton iterations summed over the converged steps.
-    pub newton_iterations: usize,
-    pub steps: Vec<StepRecord>,
 }
 
-case_record!(CaseRecord);
+case_record!(ColumnRecord);
 
 /// The column's measures in `results.json`: fitted rates, comparisons and the analytical
 /// column, all evaluated when the study is solved (so that rendering reads only this file).
@@ -63,7 +61,7 @@ pub struct ColumnMeasures {
 }
 
 /// `results.json` of a column study.
-pub type ColumnResults = Envelope<StudySpec, CaseRecord, ColumnMeasures>;
+pub type ColumnResults = Envelope<ColumnStudy, ColumnRecord, ColumnMeasures>;
 
 /// Samples of the analytical profile ([`AnalyticalRecord::profile`]): 401 equally spaced
 /// reference heights, 0 to L0.

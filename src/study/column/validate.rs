@@ -1,7 +1,7 @@
 //! Validation of a column study file: every error names the file, the key and its allowed
 //! range ([`Checker`]).
 
-use super::{FigureKind, StudySpec, Sweep};
+use super::{ColumnStudy, FigureKind, Sweep};
 use crate::method::Method;
 use crate::study::vocabulary::{max_points_per_axis, short, Checker, Header};
 use crate::study::StudyError;
@@ -14,7 +14,7 @@ const MAX_POINTS_PER_CASE: i64 = 2_000_000;
 /// the case list is built.
 const MAX_CASES_PER_SWEEP: usize = 10_000;
 
-impl StudySpec {
+impl ColumnStudy {
     /// Check every value; the error names the file, the key and its allowed range.
     pub(super) fn check(&self, file: &str) -> Result<(), StudyError> {
         let c = Checker { file };

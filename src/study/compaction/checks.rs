@@ -295,10 +295,11 @@ pub(super) fn compute_checks(results: &CompactionResults) -> Vec<CheckRecord> {
         let worst = results
             .sweep(&e.sweep)
             .into_iter()
-            .filter(|c| c.status == CaseStatus::Converged)
+            .filter(|c| c.solve.status == CaseStatus::Converged)
             .filter_map(|c| {
-                let cg: usize = c.steps.iter().map(|s| s.linear_iterations).sum();
-                (cg > 0 && c.newton_iterations > 0).then(|| cg as f64 / c.newton_iterations as f64)
+                let cg: usize = c.solve.steps.iter().map(|s| s.linear_iterations).sum();
+                (cg > 0 && c.solve.newton_iterations > 0)
+                    .then(|| cg as f64 / c.solve.newton_iterations as f64)
             })
             .reduce(f64::max);
         out.push(check_at_most(

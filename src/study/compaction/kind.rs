@@ -26,6 +26,7 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>, Ve
         u.is_finite().then_some(u)
     });
     let converged = solved.status == CaseStatus::Converged;
+    let failed = solved.status == CaseStatus::Failed;
     let steps = o.as_ref().map_or(&[][..], |o| &o.steps[..]);
     let rec = CompactionRecord {
         id: case.id.clone(),
@@ -38,14 +39,11 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>, Ve
         ghost_faces: s.ghost.faces,
         steps_cut: steps.iter().filter(|s| s.cutbacks() > 0).count(),
         cutbacks: steps.iter().map(|s| s.cutbacks()).sum(),
-        status: solved.status,
-        failure: solved.failure,
+        solve: solved,
         max_horizontal_displacement: u.filter(|_| converged),
-        last_converged_displacement: u.filter(|_| solved.status == CaseStatus::Failed),
+        last_converged_displacement: u.filter(|_| failed),
         weak_nodes_treated: o.as_ref().map_or(0, |o| o.weak_nodes_treated),
         points: o.as_ref().map_or(0, |o| o.size),
-        newton_iterations: solved.newton_iterations,
-        steps: solved.steps,
     };
     let (domains, domains_3d) = o.map_or((vec![], vec![]), |o| (o.domains, o.domains_3d));
     (rec, domains, domains_3d)
@@ -124,7 +122,7 @@ fn write_case_vtk(
     doms: &[DomainRecord],
     doms_3d: &[Domain3dRecord],
 ) -> Result<(), StudyError> {
-    let steps = rec.steps.len();
+    let steps = rec.solve.steps.len();
     let frame = |step: usize, domains: Vec<DomainBox>, scalars| DomainFrame {
         time: step as f64 / case.spec.load_steps.max(1) as f64,
         step,
@@ -135,31 +133,15 @@ fn write_case_vtk(
     let (initial, last, stress, plastic): (Vec<DomainBox>, Vec<DomainBox>, Vec<f64>, Vec<f64>) =
         if case.spec.dimension == 3 {
             (
-                doms_3d
-                    .iter()
-                    .map(|d| DomainBox {
-                        centre: d.x0,
-                        half: d.half0,
-                    })
-                    .collect(),
-                doms_3d
-                    .iter()
-                    .map(|d| DomainBox {
-                        centre: d.x,
-                        half: d.half,
-                    })
-                    .collect(),
+                doms_3d.iter().map(|d| DomainBox::new(d.x0, d.half0)).collect(),
+                doms_3d.iter().map(|d| DomainBox::new(d.x, d.half)).collect(),
                 doms_3d.iter().map(|d| d.sigma_zz).collect(),
                 doms_3d.iter().map(|d| d.plastic_multiplier).collect(),
             )
         } else {
             (
-                doms.iter()
-                    .map(|d| [d.x0[0], d.x0[1], d.half0[0], d.half0[1]].into())
-                    .collect(),
-                doms.iter()
-                    .map(|d| [d.x[0], d.x[1], d.half[0], d.half[1]].into())
-                    .collect(),
+                doms.iter().map(|d| DomainBox::new(d.x0, d.half0)).collect(),
+                doms.iter().map(|d| DomainBox::new(d.x, d.half)).collect(),
                 doms.iter().map(|d| d.sigma_yy).collect(),
                 doms.iter().map(|d| d.plastic_multiplier).collect(),
             )

@@ -3,7 +3,7 @@
 
 use super::CompactionStudy;
 use crate::method::Method;
-use crate::study::results::{case_record, CaseStatus, Envelope, FailureRecord, StepRecord};
+use crate::study::results::{case_record, Envelope, SolveRecord};
 use serde::{Deserialize, Serialize};
 
 /// Result of one case.
@@ -24,8 +24,9 @@ pub struct CompactionRecord {
     /// Load steps that needed cutbacks, and the failed attempts in all.
     pub steps_cut: usize,
     pub cutbacks: usize,
-    pub status: CaseStatus,
-    pub failure: Option<FailureRecord>,
+    /// Status, failure, Newton iterations and residual histories (flattened into the record).
+    #[serde(flatten)]
+    pub solve: SolveRecord,
     /// Bottom-right point's horizontal displacement plus half its domain's growth (Figure 17);
     /// converged cases only.
     pub max_horizontal_displacement: Option<f64>,
@@ -35,8 +36,6 @@ pub struct CompactionRecord {
     pub weak_nodes_treated: usize,
     /// Material points (iGIMP) or elements (FEM).
     pub points: usize,
-    pub newton_iterations: usize,
-    pub steps: Vec<StepRecord>,
 }
 
 /// The value Figure 17 is normalised by.

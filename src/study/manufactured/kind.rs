@@ -35,13 +35,10 @@ fn solve_case(case: &ManufacturedCase) -> (ManufacturedRecord, CasePoints) {
             .then_some(case.spec.domain_update),
         cells: case.spec.cells,
         points_per_cell: mp.then_some(case.spec.points_per_cell),
-        status: solved.status,
-        failure: solved.failure,
+        solve: solved,
         displacement_error: errors.map(|e| e.displacement),
         stress_error: errors.map(|e| e.stress),
         points: points.points.len() + points.points_3d.len(),
-        newton_iterations: solved.newton_iterations,
-        steps: solved.steps,
     };
     (rec, points)
 }
@@ -179,7 +176,10 @@ impl StudyKind for ManufacturedStudy {
     /// `domains.json`, the points of the cases a domain figure draws.
     fn write_side_files(&self, dir: &Path, outputs: &[Self::Output]) -> Result<(), StudyError> {
         let pdir = fresh_points_dir(dir)?;
-        for (r, p) in outputs.iter().filter(|(r, _)| r.status == CaseStatus::Converged) {
+        for (r, p) in outputs
+            .iter()
+            .filter(|(r, _)| r.solve.status == CaseStatus::Converged)
+        {
             let path = confined(&pdir, &format!("{}.csv", r.id))?;
             let csv = if p.points_3d.is_empty() {
                 points_csv(&p.points)
@@ -202,22 +202,13 @@ fn write_case_vtk(
 ) -> Result<(), StudyError> {
     let d = c.spec.dimension;
     let domains: Vec<DomainBox> = if d == 3 {
-        p.points_3d
-            .iter()
-            .map(|q| DomainBox {
-                centre: q.x,
-                half: q.half,
-            })
-            .collect()
+        p.points_3d.iter().map(|q| DomainBox::new(q.x, q.half)).collect()
     } else {
-        p.points
-            .iter()
-            .map(|q| [q.x[0], q.x[1], q.half[0], q.half[1]].into())
-            .collect()
+        p.points.iter().map(|q| DomainBox::new(q.x, q.half)).collect()
     };
     let frame = DomainFrame {
         time: 1.0,
-        step: rec.steps.len(),
+        step: rec.solve.steps.len(),
         dimension: d,
         domains,
         scalars: vec![("stress_error".into(), p.stress_error.clone())],

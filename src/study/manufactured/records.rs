@@ -6,7 +6,7 @@ use crate::method::Method;
 use crate::mpm::DomainUpdate;
 use crate::problems::manufactured::{Field, PointValue};
 use crate::problems::manufactured3d::PointValue3;
-use crate::study::results::{case_record, CaseStatus, Envelope, FailureRecord, StepRecord};
+use crate::study::results::{case_record, Envelope, SolveRecord};
 use serde::{Deserialize, Serialize};
 
 /// Result of one case.
@@ -21,15 +21,14 @@ pub struct ManufacturedRecord {
     pub cells: usize,
     /// MPM and iGIMP only.
     pub points_per_cell: Option<usize>,
-    pub status: CaseStatus,
-    pub failure: Option<FailureRecord>,
+    /// Status, failure, Newton iterations and residual histories (flattened into the record).
+    #[serde(flatten)]
+    pub solve: SolveRecord,
     /// Converged cases only.
     pub displacement_error: Option<f64>,
     pub stress_error: Option<f64>,
     /// Material or Gauss points.
     pub points: usize,
-    pub newton_iterations: usize,
-    pub steps: Vec<StepRecord>,
 }
 
 case_record!(ManufacturedRecord);

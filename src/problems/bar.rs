@@ -1,0 +1,339 @@
+//! The vibrating bar (Sulsky, Chen & Schreyer 1994 §5; Bardenhagen & Kober 2004 §5.1): a
+//! fixed–free elastic bar of length L, set moving in its first mode,
+//!
+//! ```text
+//! v(X, 0) = v₀ sin(πX / 2L),   u(X, t) = (v₀/ω) sin(πX / 2L) sin(ωt),   ω = πc / 2L,
+//! ```
+//!
+//! c = √(E/ρ) (ν = 0, so the uniaxial-strain modulus is E), period T = 4L/c. It is solved by
+//! Newmark time stepping ([`crate::dynamics`]) with the material point methods in 1D and the
+//! updated-Lagrangian line elements as comparators. The
+//! measures are the top point's displacement history, the period measured from its zero
+//! crossings, the total energy (kinetic + strain; no external work) and the displacement error
+//! at the end against the analytical field. At small v₀/c the finite-deformation solution is
+//! the linear one to O(v₀/c) (the strain amplitude).
+
+use crate::basis::DomainUpdate;
+use crate::constitutive::LinearElastic;
+use crate::dynamics::{LoadHistory, MassMatrix, Newmark};
+use crate::error::{require_count, require_positive, InputError, SolveError};
+use crate::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
+use crate::grid::Grid;
+use crate::kinematics::log_strain;
+use crate::load_stepping::{LoadStepping, StepReport};
+use crate::method::Method;
+use crate::mpm::{Loads, MpmSettings, MpmSolver};
+use crate::newton::NewtonSettings;
+use crate::particles::MaterialPoints;
+use nalgebra::SVector;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// One vibrating bar analysis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BarSpec {
+    pub length: f64,
+    pub young_modulus: f64,
+    pub density: f64,
+    /// Peak initial velocity v₀ (at the free end).
+    pub velocity: f64,
+    pub elements: usize,
+    pub points_per_cell: usize,
+    /// Time steps per period T = 4L/c.
+    pub steps_per_period: usize,
+    /// Simulated time in periods.
+    pub periods: f64,
+    pub beta: f64,
+    pub gamma: f64,
+    pub mass: MassMatrix,
+    pub newton: NewtonSettings,
+}
+
+impl Default for BarSpec {
+    /// A unit bar (E = 100, ρ = 1: c = 10, T = 0.4) at strain amplitude v₀/c = 1e-4, 16
+    /// elements of 2 points, 64 steps per period, one period, trapezoidal rule, consistent mass.
+    fn default() -> Self {
+        BarSpec {
+            length: 1.0,
+            young_modulus: 100.0,
+            density: 1.0,
+            velocity: 1e-3,
+            elements: 16,
+            points_per_cell: 2,
+            steps_per_period: 64,
+            periods: 1.0,
+            beta: 0.25,
+            gamma: 0.5,
+            mass: MassMatrix::Consistent,
+            newton: NewtonSettings::default(),
+        }
+    }
+}
+
+/// What one analysis measured.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BarOutcome {
+    pub steps: Vec<StepReport>,
+    pub failure: Option<SolveError>,
+    /// (t, u of the free-end point) at t = 0 and after every step.
+    pub top_history: Vec<(f64, f64)>,
+    /// Total energy (kinetic + strain) at t = 0 and after every step.
+    pub energy: Vec<f64>,
+    /// The period from the top point's downward zero crossings of u (linear interpolation
+    /// between steps); `None` if fewer than two were seen.
+    pub measured_period: Option<f64>,
+    /// (X_p, u_p, V_p0) of every point at the end.
+    pub points: Vec<[f64; 3]>,
+}
+
+impl BarSpec {
+    pub fn validate(&self) -> Result<(), InputError> {
+        require_positive("bar.length", self.length)?;
+        require_positive("bar.young_modulus", self.young_modulus)?;
+        require_positive("bar.density", self.density)?;
+        crate::error::require_finite("bar.velocity", self.velocity)?;
+        require_count("bar.elements", self.elements, 1)?;
+        require_count("bar.points_per_cell", self.points_per_cell, 1)?;
+        require_count("bar.steps_per_period", self.steps_per_period, 1)?;
+        require_positive("bar.periods", self.periods)?;
+        self.newmark().validate()
+    }
+
+    /// Wave speed c = √(E/ρ).
+    pub fn wave_speed(&self) -> f64 {
+        (self.young_modulus / self.density).sqrt()
+    }
+
+    /// T = 4L/c.
+    pub fn period(&self) -> f64 {
+        4.0 * self.length / self.wave_speed()
+    }
+
+    /// ω = 2π / T.
+    pub fn omega(&self) -> f64 {
+        2.0 * PI / self.period()
+    }
+
+    /// The analytical displacement u(X, t).
+    pub fn exact_displacement(&self, x: f64, t: f64) -> f64 {
+        self.velocity / self.omega() * (PI * x / (2.0 * self.length)).sin() * (self.omega() * t).sin()
+    }
+
+    /// Total time steps.
+    pub fn time_steps(&self) -> usize {
+        (self.periods * self.steps_per_period as f64).round().max(1.0) as usize
+    }
+
+    fn newmark(&self) -> Newmark {
+        Newmark {
+            duration: self.periods * self.period(),
+            beta: self.beta,
+            gamma: self.gamma,
+            mass: self.mass,
+            load: LoadHistory::None,
+        }
+    }
+
+    /// The solver: grid [0, L + h] (one cell beyond the free end, so that its domain stays
+    /// inside), node 0 fixed, points with v_p = v₀ sin(πX_p / 2L).
+    pub fn mpm_solver(&self, method: Method) -> Result<MpmSolver<1>, InputError> {
+        self.validate()?;
+        let basis = method
+            .basis()
+            .ok_or_else(|| method.unsupported("bar", &Method::MATERIAL_POINT))?;
+        let h = self.length / self.elements as f64;
+        let grid = Grid::try_new([0.0], [h], [self.elements + 1])?;
+        let mut points =
+            MaterialPoints::fill_box(&grid, [0.0], [self.length], [self.points_per_cell], self.density)?;
+        for p in 0..points.len() {
+            let x = points.position0[p][0];
+            points.velocity[p][0] = self.velocity * (PI * x / (2.0 * self.length)).sin();
+        }
+        let settings = MpmSettings {
+            basis,
+            domain_update: DomainUpdate::Stretch,
+            newton: self.newton,
+            load_steps: self.time_steps(),
+            weak_node_tolerance: 0.0,
+            weak_node_treatment: Default::default(),
+            volume_update: Default::default(),
+            linear_solver: Default::default(),
+            ghost: Default::default(),
+            dynamics: Some(self.newmark()),
+        };
+        let loads = Loads {
+            gravity: SVector::zeros(),
+            point_loads: vec![],
+        };
+        let model = Box::new(LinearElastic::try_new(self.young_modulus, 0.0)?);
+        MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, settings)
+    }
+}
+
+/// Kinetic plus strain energy of the points: Σ ½ m_p v_p² + Σ ½ τ_p : ε_p v_p0 (Hencky: the
+/// stored energy per reference volume is ½ τ : ε with ε the logarithmic strain).
+pub fn total_energy<const D: usize>(solver: &MpmSolver<D>) -> f64 {
+    let p = &solver.points;
+    (0..p.len())
+        .map(|i| {
+            let kinetic = 0.5 * p.mass[i] * p.velocity[i].norm_squared();
+            let s = &p.state[i];
+            let eps = log_strain(&(s.f * s.f.transpose())).unwrap_or_else(nalgebra::Matrix3::zeros);
+            kinetic + 0.5 * s.tau.component_mul(&eps).sum() * p.volume0[i]
+        })
+        .sum()
+}
+
+/// Solve one bar analysis: material point families and line elements (Line2, Line3).
+pub fn solve(spec: &BarSpec, method: Method) -> Result<BarOutcome, InputError> {
+    match method {
+        Method::FEM_LINEAR => solve_fem(spec, LineElement::Linear),
+        Method::FEM_QUADRATIC => solve_fem(spec, LineElement::Quadratic),
+        _ => solve_mpm(spec, method),
+    }
+}
+
+/// The bar by updated-Lagrangian line elements: node 0 fixed, nodal velocities v₀ sin(πX/2L),
+/// `points_per_cell` Gauss points per element (the measures are taken at them).
+pub fn fem_solver(spec: &BarSpec, element: LineElement) -> Result<LineFem, InputError> {
+    spec.validate()?;
+    let mesh = LineMesh::uniform(element, 0.0, spec.length, spec.elements)?;
+    let settings = LineFemSettings {
+        gauss_points: spec.points_per_cell,
+        newton: spec.newton,
+        load_steps: spec.time_steps(),
+    };
+    let loads = LineLoads {
+        gravity: 0.0,
+        nodal_forces: vec![],
+    };
+    let model = Box::new(LinearElastic::try_new(spec.young_modulus, 0.0)?);
+    let velocity: Vec<f64> = mesh
+        .nodes
+        .iter()
+        .map(|&x| spec.velocity * (PI * x / (2.0 * spec.length)).sin())
+        .collect();
+    let mut fem = LineFem::try_new(mesh, spec.density, model, vec![0], loads, settings)?;
+    fem.set_dynamics(spec.newmark(), velocity)?;
+    Ok(fem)
+}
+
+/// Kinetic plus strain energy of a line-element bar: ½ Σ_q m_q (Σ_a N_a(ξ_q) v_a)² (the
+/// consistent kinetic energy; with the lumped mass ½ Σ_a m_a v_a²) + Σ_q ½ τ ε v_q0.
+pub fn fem_energy(fem: &LineFem, mass: MassMatrix) -> f64 {
+    let g = &fem.gauss;
+    let v = fem.velocity();
+    let k = fem.mesh.element.nodes_per_element();
+    let mut lumped = vec![0.0; v.len()];
+    let mut energy = 0.0;
+    for q in 0..g.len() {
+        let (n, _) = fem.mesh.element.shape(g.xi[q]);
+        let first = fem.mesh.first_node(g.element[q]);
+        let vq: f64 = (0..k).map(|a| n[a] * v[first + a]).sum();
+        match mass {
+            MassMatrix::Consistent => energy += 0.5 * g.mass[q] * vq * vq,
+            MassMatrix::Lumped => (0..k).for_each(|a| lumped[first + a] += n[a] * g.mass[q]),
+        }
+        let s = &g.state[q];
+        let eps = log_strain(&(s.f * s.f.transpose())).unwrap_or_else(nalgebra::Matrix3::zeros);
+        energy += 0.5 * s.tau.component_mul(&eps).sum() * g.volume0[q];
+    }
+    energy + lumped.iter().zip(v).map(|(m, v)| 0.5 * m * v * v).sum::<f64>()
+}
+
+fn solve_fem(spec: &BarSpec, element: LineElement) -> Result<BarOutcome, InputError> {
+    let mut fem = fem_solver(spec, element)?;
+    let top = fem.mesh.num_nodes() - 1;
+    let mut top_history = vec![(0.0, 0.0)];
+    let mut energy = vec![fem_energy(&fem, spec.mass)];
+    let result = fem.run_observed(&mut |s, _| {
+        top_history.push((s.time(), s.displacement(top)));
+        energy.push(fem_energy(s, spec.mass));
+    });
+    let (steps, failure) = match result {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    let points = (0..fem.gauss.len())
+        .map(|q| {
+            let x0 = fem.gauss.position0[q];
+            [x0, fem.gauss_point_map(q).0 - x0, fem.gauss.volume0[q]]
+        })
+        .collect();
+    Ok(BarOutcome {
+        steps,
+        failure,
+        measured_period: period_of(&top_history),
+        top_history,
+        energy,
+        points,
+    })
+}
+
+fn solve_mpm(spec: &BarSpec, method: Method) -> Result<BarOutcome, InputError> {
+    let mut solver = spec.mpm_solver(method)?;
+    let top = (0..solver.points.len())
+        .max_by(|&a, &b| solver.points.position0[a][0].total_cmp(&solver.points.position0[b][0]))
+        .expect("points");
+    let mut top_history = vec![(0.0, 0.0)];
+    let mut energy = vec![total_energy(&solver)];
+    let result = solver.run_observed(&mut |s, _| {
+        top_history.push((s.time(), s.points.position[top][0] - s.points.position0[top][0]));
+        energy.push(total_energy(s));
+    });
+    let (steps, failure) = match result {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    let p = &solver.points;
+    Ok(BarOutcome {
+        steps,
+        failure,
+        measured_period: period_of(&top_history),
+        top_history,
+        energy,
+        points: (0..p.len())
+            .map(|i| {
+                [
+                    p.position0[i][0],
+                    p.position[i][0] - p.position0[i][0],
+                    p.volume0[i],
+                ]
+            })
+            .collect(),
+    })
+}
+
+/// The mean spacing of the downward zero crossings of u(t) (u from positive to non-positive),
+/// each located by linear interpolation between its two samples.
+pub fn period_of(history: &[(f64, f64)]) -> Option<f64> {
+    let crossings: Vec<f64> = history
+        .windows(2)
+        .filter(|w| w[0].1 > 0.0 && w[1].1 <= 0.0)
+        .map(|w| w[0].0 + (w[1].0 - w[0].0) * w[0].1 / (w[0].1 - w[1].1))
+        .collect();
+    (crossings.len() >= 2)
+        .then(|| (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64)
+}
+
+impl BarOutcome {
+    /// ‖u_h − u‖ / ‖u‖ over the points at time `t` (volume-weighted L2, the discrete form of
+    /// eq (46) for displacements).
+    pub fn displacement_error(&self, spec: &BarSpec, t: f64) -> f64 {
+        let (mut num, mut den) = (0.0, 0.0);
+        let amplitude = spec.velocity / spec.omega();
+        for [x, u, v] in &self.points {
+            let e = spec.exact_displacement(*x, t);
+            num += v * (u - e).powi(2);
+            den += v * (amplitude * (PI * x / (2.0 * spec.length)).sin()).powi(2);
+        }
+        (num / den).sqrt()
+    }
+
+    /// max_t |E(t) − E(0)| / E(0).
+    pub fn energy_drift(&self) -> f64 {
+        let e0 = self.energy[0];
+        self.energy.iter().map(|e| (e - e0).abs()).fold(0.0, f64::max) / e0
+    }
+}

@@ -1,0 +1,243 @@
+//! Rendering of the vibrating-bar study: the report (every case's error, period and energy,
+//! fitted rates with their bands, checks), the log-log convergence figures and the free end's
+//! history against the analytical one, from `results.json` and `histories.json` only.
+
+use super::{checks_markdown, failures_markdown, IndexEntry};
+use crate::plot::{convergence_svg_along, profile_svg, ConvergenceSeries, ProfileSeries};
+use crate::study::bar::kind::{mass_tag, History};
+use crate::study::bar::records::BarResults;
+use crate::study::bar::{BarMeasure, FigureKind, FigureSpec, Refinement};
+use crate::study::checks::check_counts;
+use crate::study::results::{read_json, read_results};
+use crate::study::StudyError;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+fn e3(x: Option<f64>) -> String {
+    x.map_or("—".into(), |v| format!("{v:.3e}"))
+}
+
+fn r2(x: Option<f64>) -> String {
+    x.map_or("—".into(), |v| format!("{v:.2}"))
+}
+
+pub fn report_markdown(results: &BarResults, not_drawn: &[super::NotDrawn]) -> String {
+    let study = &results.study;
+    let b = &study.bar;
+    let (pass, fail, none) = check_counts(&results.checks);
+    let mut s = format!(
+        "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated.\n\n",
+        study.name,
+        study.summary,
+        results.provenance.line()
+    );
+    let _ = writeln!(
+        s,
+        "A fixed–free bar, L = {}, E = {}, ρ = {}, ν = 0 (Hencky), set moving in its first mode v(X, 0) = v₀ sin(πX/2L) with v₀ = {} (strain amplitude v₀/c = {:.1e}); Newmark β = {}, γ = {} over {} periods of T = 4L/c = {}. Errors: displacement ‖u_h − u‖/‖u‖ over the points at the end against u = (v₀/ω) sin(πX/2L) sin(ωt); period from the free end's downward zero crossings; energy max |E(t) − E(0)|/E(0), E = kinetic + strain. Rates are slopes of log(measure) against log(h) (space sweeps) or log(Δt) (time sweeps).\n",
+        b.length,
+        b.young_modulus,
+        b.density,
+        b.velocity,
+        b.velocity / (b.young_modulus / b.density).sqrt(),
+        b.beta,
+        b.gamma,
+        b.periods,
+        results.measures.exact_period
+    );
+    for sw in &study.sweeps {
+        if !results.sweep_cases.contains_key(&sw.id) {
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            "## {}\n\n{}\n\n| case | elements | steps per period | displacement | period | period error | energy | Newton iterations |\n|---|---:|---:|---:|---:|---:|---:|---:|",
+            sw.id, sw.title
+        );
+        for ser in results.sweep_series(&sw.id) {
+            for c in results.series_cases(&sw.id, &ser) {
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {} | {} | {} | {} | {} | {} |",
+                    c.id,
+                    c.elements,
+                    c.steps_per_period,
+                    e3(c.displacement_error),
+                    c.measured_period.map_or("—".into(), |t| format!("{t:.6}")),
+                    e3(c.period_error),
+                    e3(c.energy_drift),
+                    c.solve.newton_iterations
+                );
+            }
+        }
+        s.push('\n');
+    }
+    s.push_str("## Fitted rates\n\n| sweep | series | measure | against | levels | slope | band | source |\n|---|---|---|---|---|---:|---|---|\n");
+    for r in &results.measures.rates {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {:?} | {} | {} | {} |",
+            r.sweep,
+            r.series.label(),
+            r.measure.name(),
+            if r.refinement == Refinement::Time {
+                "Δt"
+            } else {
+                "h"
+            },
+            r.levels_used,
+            r2(r.slope),
+            r.expected
+                .as_ref()
+                .map_or("—".into(), |e| format!("{} ± {}", e.rate, e.tolerance)),
+            r.expected
+                .as_ref()
+                .map_or(String::new(), |e| e.source.replace('|', "\\|"))
+        );
+    }
+    s.push('\n');
+    s.push_str(&checks_markdown(&results.checks));
+    s.push_str(&super::performance_markdown(&results.cases, &results.timing));
+    s.push_str(&failures_markdown(
+        results
+            .cases
+            .iter()
+            .map(|c| (c.id.as_str(), c.solve.status, c.solve.failure.as_ref())),
+    ));
+    s.push_str(&super::figures_markdown(
+        super::figures_in_tier(&study.figures, &study.sweeps, results.provenance.tier)
+            .map(|f| (f.title.as_str(), f.id.as_str())),
+        not_drawn,
+    ));
+    s
+}
+
+fn render_figure(
+    results: &BarResults,
+    histories: &BTreeMap<String, History>,
+    dir: &Path,
+    f: &FigureSpec,
+) -> Result<Option<String>, StudyError> {
+    let err = |e: String| StudyError::io(&dir.join(format!("{}.svg", f.id)), e);
+    let Some(sw) = results.study.sweep(&f.sweep) else {
+        return Ok(None);
+    };
+    match f.kind {
+        FigureKind::Convergence => {
+            let m = f.measure.unwrap_or(BarMeasure::Displacement);
+            let refinement = sw.refinement();
+            let series: Vec<ConvergenceSeries> = results
+                .sweep_series(&f.sweep)
+                .into_iter()
+                .filter_map(|ser| {
+                    let points: Vec<(f64, f64)> = results
+                        .series_cases(&f.sweep, &ser)
+                        .into_iter()
+                        .filter_map(|c| {
+                            let n = match refinement {
+                                Refinement::Space => c.elements,
+                                Refinement::Time => c.steps_per_period,
+                            };
+                            Some((n as f64, c.measure(m)?)).filter(|p| p.1 > 0.0)
+                        })
+                        .collect();
+                    let slope = results
+                        .measures
+                        .rates
+                        .iter()
+                        .find(|r| r.sweep == f.sweep && r.series == ser && r.measure == m)
+                        .and_then(|r| r.slope);
+                    (points.len() >= 2).then(|| ConvergenceSeries {
+                        label: ser.label(),
+                        points,
+                        slope,
+                    })
+                })
+                .collect();
+            if series.is_empty() {
+                return Ok(None);
+            }
+            let x = match refinement {
+                Refinement::Space => "elements (h = L/n)",
+                Refinement::Time => "time steps per period (Δt = T/n)",
+            };
+            convergence_svg_along(&f.title, x, m.label(), &series, m != BarMeasure::Energy)
+                .map(Some)
+                .map_err(err)
+        }
+        FigureKind::History => {
+            let b = &results.study.bar;
+            let t_period = results.measures.exact_period;
+            let amplitude = b.velocity / (2.0 * std::f64::consts::PI / t_period);
+            let series: Vec<ProfileSeries> = results
+                .sweep(&f.sweep)
+                .into_iter()
+                .filter_map(|c| {
+                    let h = histories.get(&c.id)?;
+                    Some(ProfileSeries {
+                        label: format!(
+                            "{} ({} mass, {} el., {}/T)",
+                            c.method.label(),
+                            mass_tag(c.mass),
+                            c.elements,
+                            c.steps_per_period
+                        ),
+                        points: h.iter().map(|p| (p[0] / t_period, p[1] / amplitude)).collect(),
+                    })
+                })
+                .collect();
+            if series.is_empty() {
+                return Ok(None);
+            }
+            let samples = 400;
+            let exact = ProfileSeries {
+                label: "analytical".into(),
+                points: (0..=samples)
+                    .map(|i| {
+                        let t = b.periods * i as f64 / samples as f64;
+                        (t, (2.0 * std::f64::consts::PI * t).sin())
+                    })
+                    .collect(),
+            };
+            profile_svg(&f.title, "t / T", "u(L, t) / (v₀/ω)", &series, &[exact])
+                .map(Some)
+                .map_err(err)
+        }
+    }
+}
+
+/// Render the report and figures from `dir`'s `results.json` and `histories.json`.
+pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
+    let results: BarResults = read_results(dir)?;
+    let histories: BTreeMap<String, History> = read_json(&dir.join("histories.json"))?;
+    let mut files = super::Files::new(dir);
+    for f in super::figures_in_tier(
+        &results.study.figures,
+        &results.study.sweeps,
+        results.provenance.tier,
+    ) {
+        files.figure(
+            &f.id,
+            render_figure(&results, &histories, dir, f)?,
+            "no data (no converged case among those it shows)",
+        )?;
+    }
+    let report = report_markdown(&results, &files.not_drawn);
+    files.report(&results.study.report_file, &report)?;
+    Ok(files.done())
+}
+
+pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
+    let r: BarResults = read_results(dir)?;
+    Ok(super::plane_index_entry(
+        (&r.study.name, &r.study.summary, r.provenance.tier),
+        ("the free-end histories", "histories.json"),
+        &r.checks,
+        &r.study.report_file,
+        std::iter::empty(),
+        super::drawn(
+            dir,
+            r.study.figures.iter().map(|f| (f.title.clone(), f.id.clone())),
+        ),
+    ))
+}

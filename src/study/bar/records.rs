@@ -1,0 +1,126 @@
+//! What a vibrating-bar study's `results.json` holds besides the envelope: the case records
+//! (error, period, energy) and the fitted rates.
+
+use super::{BarMeasure, BarStudy, Refinement};
+use crate::dynamics::MassMatrix;
+use crate::method::Method;
+use crate::study::results::{case_record, Envelope, SolveRecord};
+use serde::{Deserialize, Serialize};
+
+/// Result of one case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BarRecord {
+    pub id: String,
+    pub method: Method,
+    pub mass: MassMatrix,
+    pub elements: usize,
+    pub points_per_cell: usize,
+    pub steps_per_period: usize,
+    /// Status, failure, Newton iterations and residual histories (flattened into the record).
+    #[serde(flatten)]
+    pub solve: SolveRecord,
+    /// Converged cases only.
+    pub displacement_error: Option<f64>,
+    /// The period measured from the free end's zero crossings, and its relative error.
+    pub measured_period: Option<f64>,
+    pub period_error: Option<f64>,
+    pub energy_drift: Option<f64>,
+    pub points: usize,
+}
+
+case_record!(BarRecord);
+
+impl BarRecord {
+    pub fn measure(&self, m: BarMeasure) -> Option<f64> {
+        match m {
+            BarMeasure::Displacement => self.displacement_error,
+            BarMeasure::Period => self.period_error,
+            BarMeasure::Energy => self.energy_drift,
+        }
+    }
+    pub fn series(&self) -> Series {
+        Series {
+            method: self.method,
+            mass: self.mass,
+            points_per_cell: self.points_per_cell,
+        }
+    }
+}
+
+/// The cases of a sweep that differ only in the refined variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct Series {
+    pub method: Method,
+    pub mass: MassMatrix,
+    pub points_per_cell: usize,
+}
+
+impl Series {
+    pub fn label(&self) -> String {
+        let mass = match self.mass {
+            MassMatrix::Consistent => "consistent",
+            MassMatrix::Lumped => "lumped",
+        };
+        format!(
+            "{} ({mass} mass, {} ppc)",
+            self.method.label(),
+            self.points_per_cell
+        )
+    }
+}
+
+/// A band a rate is checked against.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ExpectedBand {
+    pub rate: f64,
+    pub tolerance: f64,
+    pub source: String,
+}
+
+/// Fitted rate of one series under one measure: slope of log(measure) against log(h) or
+/// log(Δt).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RateRecord {
+    pub sweep: String,
+    pub series: Series,
+    pub measure: BarMeasure,
+    pub refinement: Refinement,
+    pub slope: Option<f64>,
+    /// Elements (space) or steps per period (time) of the fitted levels.
+    pub levels_used: Vec<usize>,
+    pub expected: Option<ExpectedBand>,
+}
+
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct BarMeasures {
+    pub rates: Vec<RateRecord>,
+    /// The analytical period 4L/c.
+    pub exact_period: f64,
+}
+
+/// `results.json` of a vibrating-bar study.
+pub type BarResults = Envelope<BarStudy, BarRecord, BarMeasures>;
+
+impl BarResults {
+    /// The series of a sweep in plan order.
+    pub fn sweep_series(&self, sweep: &str) -> Vec<Series> {
+        let mut out: Vec<Series> = vec![];
+        for c in self.sweep(sweep) {
+            if !out.contains(&c.series()) {
+                out.push(c.series());
+            }
+        }
+        out
+    }
+
+    /// One series' cases, coarse to fine in the sweep's refined variable.
+    pub fn series_cases(&self, sweep: &str, s: &Series) -> Vec<&BarRecord> {
+        let mut v: Vec<&BarRecord> = self
+            .sweep(sweep)
+            .into_iter()
+            .filter(|c| c.series() == *s)
+            .collect();
+        v.sort_by_key(|c| (c.elements, c.steps_per_period));
+        v
+    }
+}

@@ -1,0 +1,92 @@
+//! The vibrating-bar study (`studies/vibrating-bar.toml`), quick tier: every check passes (the
+//! trapezoidal rule second order in Δt for the material point families and Line2, each family
+//! second order in h, the period within 0.5 %, the energy bounded), the outputs re-render byte
+//! for byte, and the time-rate band fails for a damped Newmark (γ = 0.6: first order).
+
+use igimp::render::bar::render;
+use igimp::study::bar::BarStudy;
+use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
+use igimp::study::Tier;
+use std::path::Path;
+use std::sync::OnceLock;
+
+fn study() -> BarStudy {
+    BarStudy::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/vibrating-bar.toml"))
+        .expect("studies/vibrating-bar.toml parses")
+}
+
+fn quick() -> &'static Run<BarStudy> {
+    static RUN: OnceLock<Run<BarStudy>> = OnceLock::new();
+    RUN.get_or_init(|| run_in_memory(&study(), "vibrating-bar.toml", Tier::Quick).expect("an in-memory run"))
+}
+
+/// The quick tier's 14 checks are all evaluated and pass.
+#[test]
+fn every_bar_check_passes() {
+    let r = &quick().results;
+    assert_eq!(
+        r.checks.len(),
+        14,
+        "{:?}",
+        r.checks.iter().map(|c| &c.id).collect::<Vec<_>>()
+    );
+    for c in &r.checks {
+        assert_eq!(
+            c.pass,
+            Some(true),
+            "{}: {} (measured {:?})",
+            c.id,
+            c.description,
+            c.measured
+        );
+    }
+}
+
+/// Rendering twice from the written results gives the same bytes, and the history figure is
+/// drawn from `histories.json`.
+#[test]
+fn bar_outputs_rerender_byte_identically() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = write_outputs(tmp.path(), quick()).unwrap();
+    let first = render(&dir).unwrap();
+    assert!(first.not_drawn.is_empty(), "{:?}", first.not_drawn);
+    let read = |f: &str| std::fs::read(dir.join(f)).unwrap();
+    let files = [
+        "report.md",
+        "history.svg",
+        "time-displacement.svg",
+        "space-displacement.svg",
+    ];
+    let before: Vec<Vec<u8>> = files.iter().map(|f| read(f)).collect();
+    render(&dir).unwrap();
+    for (f, b) in files.iter().zip(before) {
+        assert_eq!(read(f), b, "{f} changed on re-render");
+    }
+}
+
+/// γ = 0.6 damps the response and makes Newmark first order in Δt: the iGIMP time-rate band
+/// 2.0 ± 0.2 must fail (the check can fail).
+#[test]
+fn damped_newmark_fails_the_time_rate_band() {
+    let mut s = study();
+    s.bar.gamma = 0.6;
+    s.bar.beta = 0.3025; // (γ + 1/2)² / 4: unconditionally stable with γ = 0.6
+    s.sweeps.retain(|x| x.id == "time");
+    s.expect_rate.retain(|x| x.sweep == "time");
+    s.expect_at_most.clear();
+    s.figures.clear();
+    let run = run_in_memory(&s, "vibrating-bar.toml", Tier::Quick).unwrap();
+    let c = run
+        .results
+        .checks
+        .iter()
+        .find(|c| c.id == "time-igimp-consistent-displacement-rate")
+        .expect("the iGIMP time-rate check");
+    assert_eq!(
+        c.pass,
+        Some(false),
+        "{}: measured {:?}",
+        c.description,
+        c.measured
+    );
+}
