@@ -17,10 +17,21 @@ use std::path::Path;
 pub type History = Vec<[f64; 2]>;
 
 fn solve_case(case: &BarCase) -> (BarRecord, History) {
-    let (solved, o) = match bar::solve(&case.spec, case.method) {
+    let (mut solved, o) = match bar::solve(&case.spec, case.method) {
         Err(e) => (SolveRecord::rejected(e), None),
         Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
     };
+    let time_steps = solved.steps.len();
+    let max_newton_iterations = o
+        .as_ref()
+        .and_then(|o| o.steps.iter().map(|s| s.newton.iterations()).max())
+        .unwrap_or(0);
+    let steps_at_floor = solved
+        .steps
+        .iter()
+        .filter(|s| s.accepted_at_floor.is_some())
+        .count();
+    solved.steps.drain(..time_steps.saturating_sub(1));
     let conv = o.as_ref().filter(|o| o.failure.is_none());
     let exact = case.spec.period();
     let end = case.spec.time_steps() as f64 / case.spec.steps_per_period as f64 * exact;
@@ -33,6 +44,9 @@ fn solve_case(case: &BarCase) -> (BarRecord, History) {
         points_per_cell: case.spec.points_per_cell,
         steps_per_period: case.spec.steps_per_period,
         solve: solved,
+        time_steps,
+        max_newton_iterations,
+        steps_at_floor,
         displacement_error: conv.and_then(|o| finite(o.displacement_error(&case.spec, end))),
         measured_period: conv.and_then(|o| o.measured_period),
         period_error: conv

@@ -16,9 +16,16 @@ pub struct BarRecord {
     pub elements: usize,
     pub points_per_cell: usize,
     pub steps_per_period: usize,
-    /// Status, failure, Newton iterations and residual histories (flattened into the record).
+    /// Status, failure and Newton iterations (flattened into the record); of the residual
+    /// histories only the last time step's is kept (a case runs up to 196,608 steps, whose
+    /// histories made a 364 MB `results.json`), summarised by the two fields below.
     #[serde(flatten)]
     pub solve: SolveRecord,
+    /// Converged time steps, and the most Newton iterations any of them took.
+    pub time_steps: usize,
+    pub max_newton_iterations: usize,
+    /// Time steps accepted at their round-off floor (none silently: listed here by count).
+    pub steps_at_floor: usize,
     /// Converged cases only.
     pub displacement_error: Option<f64>,
     /// The period measured from the free end's zero crossings, and its relative error.
