@@ -163,7 +163,11 @@ impl<const D: usize> LoadStepSystem<'_, D> {
     /// f += M a₁ with a₁ = Δu/(βΔt²) − ã per nodal dof: consistent, Σ_p m_p S_ap (Σ_b S_bp a₁_b);
     /// lumped, (Σ_p m_p S_ap) a₁_a. Fixed dofs take theirs into the reactions.
     fn add_inertia_residual(&mut self, inertia: &Inertia<'_>, f_int: &mut [f64]) {
-        let a1 = |dof: usize| inertia.mass_factor * self.du_nodal[dof] - inertia.predictor[dof];
+        let a1 = |dof: usize| {
+            inertia
+                .step
+                .acceleration_after(self.du_nodal[dof], inertia.predictor[dof])
+        };
         for p in 0..self.states.len() {
             let (nodes, s, _) = self.table.point(p);
             let m = inertia.point_masses[p];
@@ -322,7 +326,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                     // The inertia term's α m_p S_a S_b δ_ik (consistent mass).
                     let mass = inertia
                         .filter(|i| i.mass == MassMatrix::Consistent)
-                        .map_or(0.0, |i| i.mass_factor * i.point_masses[p]);
+                        .map_or(0.0, |i| i.step.mass_factor() * i.point_masses[p]);
                     let weights = table.point(p).1;
                     // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V.
                     for kb in 0..nodes.len() {
@@ -426,7 +430,8 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                 for (&node, &w) in nodes.iter().zip(s) {
                     for a in 0..D {
                         if let Some(e) = dofs.eq(node * D + a) {
-                            self.matrix.add(e, e, i.mass_factor * i.point_masses[p] * w);
+                            self.matrix
+                                .add(e, e, i.step.mass_factor() * i.point_masses[p] * w);
                         }
                     }
                 }

@@ -37,6 +37,16 @@ pub enum MassMatrix {
     Lumped,
 }
 
+impl MassMatrix {
+    /// The name in study files and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            MassMatrix::Consistent => "consistent",
+            MassMatrix::Lumped => "lumped",
+        }
+    }
+}
+
 /// How the external load varies in time t ∈ [0, duration].
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case", tag = "kind", deny_unknown_fields)]
@@ -124,6 +134,28 @@ impl Newmark {
             gamma: self.gamma,
         }
     }
+
+    /// The step from the committed time `time` to t₁ = `load_factor` × duration (the load
+    /// stepping's factor is t / duration, and it only advances, so t₁ > `time`; a step of
+    /// zero length would make every residual non-finite, which Newton reports).
+    pub fn step_to(&self, time: f64, load_factor: f64) -> TimeStep {
+        let end = load_factor * self.duration;
+        debug_assert!(end > time, "a time step must advance: {time} -> {end}");
+        TimeStep {
+            newmark: self.step(end - time),
+            end,
+            load_factor: self.load.factor(end),
+        }
+    }
+}
+
+/// One time step of a dynamic analysis: its Newmark coefficients, its end time and the factor
+/// the external loads take there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeStep {
+    pub newmark: NewmarkStep,
+    pub end: f64,
+    pub load_factor: f64,
 }
 
 /// (N1)–(N2) for one step of length `dt`.
@@ -148,7 +180,12 @@ impl NewmarkStep {
 
     /// a₁ from the increment (N1).
     pub fn acceleration(&self, du: f64, v0: f64, a0: f64) -> f64 {
-        du * self.mass_factor() - self.predictor(v0, a0)
+        self.acceleration_after(du, self.predictor(v0, a0))
+    }
+
+    /// a₁ = Δu/(βΔt²) − ã from the increment and the step's [`Self::predictor`] ã.
+    pub fn acceleration_after(&self, du: f64, predictor: f64) -> f64 {
+        du * self.mass_factor() - predictor
     }
 
     /// The velocity change v₁ − v₀ over the step (N2).
@@ -157,12 +194,12 @@ impl NewmarkStep {
     }
 }
 
-/// The inertia term of one step in nodal-dof order (dof = node·D + axis): the factor
-/// 1/(β Δt²), the negated predictor ã (a₁ = Δu/(βΔt²) − ã), the mass matrix kind and the mass
-/// of each integration point (m_p; for the finite elements ρ₀ w det J₀ of each Gauss point).
+/// The inertia term of one step in nodal-dof order (dof = node·D + axis): the step's
+/// coefficients, the negated predictor ã (a₁ = Δu/(βΔt²) − ã), the mass matrix kind and the
+/// mass of each integration point (m_p; for the finite elements ρ₀ w det J₀ of each Gauss point).
 #[derive(Debug, Clone, Copy)]
 pub struct Inertia<'a> {
-    pub mass_factor: f64,
+    pub step: NewmarkStep,
     pub predictor: &'a [f64],
     pub mass: MassMatrix,
     pub point_masses: &'a [f64],

@@ -3,7 +3,7 @@
 use crate::assembly::{StepInput, StepWorkspace, SupportTable};
 use crate::basis::{Basis, BasisError, BasisFamily, PointSupport};
 use crate::constitutive::ConstitutiveModel;
-use crate::dynamics::{Inertia, Newmark, NewmarkStep};
+use crate::dynamics::{Inertia, Newmark, NewmarkStep, TimeStep};
 use crate::error::{require_count, InputError, StepFailure};
 use crate::ghost::{cell_fill, node_share, GhostOperator, GhostSettings};
 use crate::grid::Grid;
@@ -517,7 +517,7 @@ impl<const D: usize> MpmSolver<D> {
             for (&node, &w) in nodes.iter().zip(s) {
                 for a in 0..D {
                     let k = node * D + a;
-                    let acc = du[k] * n.mass_factor() - m.predictor[k];
+                    let acc = n.acceleration_after(du[k], m.predictor[k]);
                     a1[a] += w * acc;
                     dv[a] += w * n.velocity_change(m.acceleration[k], acc);
                 }
@@ -541,8 +541,8 @@ macro_rules! step_input {
             point_forces: &$step.forces,
             nodal_forces: &[],
             ghost: $solver.settings.ghost.is_on().then_some(&$solver.ghost),
-            inertia: $step.newmark.map(|n| Inertia {
-                mass_factor: n.mass_factor(),
+            inertia: $step.time_step.map(|t| Inertia {
+                step: t.newmark,
                 predictor: &$solver.nodal.predictor,
                 mass: $solver.settings.dynamics.map(|d| d.mass).unwrap_or_default(),
                 point_masses: &$solver.points.mass,
@@ -558,8 +558,8 @@ struct PreparedStep<const D: usize> {
     fixed: Vec<(usize, usize)>,
     ties: Vec<(usize, usize)>,
     weak_nodes: usize,
-    /// The Newmark step of a dynamic analysis.
-    newmark: Option<NewmarkStep>,
+    /// The time step of a dynamic analysis.
+    time_step: Option<TimeStep>,
 }
 
 impl<const D: usize> MpmSolver<D> {
@@ -569,12 +569,8 @@ impl<const D: usize> MpmSolver<D> {
     fn prepare_step(&mut self, load_factor: f64) -> Result<PreparedStep<D>, StepFailure> {
         self.build_supports()?;
         self.build_ghost();
-        let newmark = self.settings.dynamics.map(|d| {
-            let t1 = load_factor * d.duration;
-            (d.step(t1 - self.time), d.load.factor(t1))
-        });
-        let forces = self.external_point_forces(newmark.map_or(load_factor, |n| n.1));
-        let newmark = newmark.map(|n| n.0);
+        let time_step = self.settings.dynamics.map(|d| d.step_to(self.time, load_factor));
+        let forces = self.external_point_forces(time_step.map_or(load_factor, |t| t.load_factor));
         let (weak, ties) = self.weak_nodes();
         let mut fixed = self.fixed.clone();
         let tied: Vec<usize> = ties.iter().map(|t| t.0).collect();
@@ -583,21 +579,15 @@ impl<const D: usize> MpmSolver<D> {
                 .filter(|n| !tied.contains(n))
                 .flat_map(|&n| (0..D).map(move |a| (n, a))),
         );
-        if let Some(n) = &newmark {
-            if n.dt.is_nan() || n.dt <= 0.0 {
-                return Err(StepFailure::Kinematics {
-                    point: 0,
-                    reason: format!("time step {:e} is not positive", n.dt),
-                });
-            }
-            self.project_motion(n, &fixed);
+        if let Some(t) = &time_step {
+            self.project_motion(&t.newmark, &fixed);
         }
         Ok(PreparedStep {
             forces,
             fixed,
             ties,
             weak_nodes: weak.len(),
-            newmark,
+            time_step,
         })
     }
 
@@ -628,10 +618,10 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
         let before = self.work.matrix.stats().iterations;
         let report = self.work.solve(&input, &self.settings.newton)?;
         let linear = self.work.linear_record(before);
-        self.commit(step.newmark)
+        self.commit(step.time_step.map(|t| t.newmark))
             .map_err(|f| (f, report.residuals.clone()))?;
-        if let Some(d) = self.settings.dynamics {
-            self.time = load_factor * d.duration;
+        if let Some(t) = step.time_step {
+            self.time = t.end;
         }
         Ok(Increment {
             newton: report,

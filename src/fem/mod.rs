@@ -185,10 +185,7 @@ impl LineFem {
                 format!("one finite value per node ({})", self.mesh.num_nodes()),
             ));
         }
-        self.core.dynamics = Some(newmark);
-        self.core.motion.acceleration = vec![0.0; velocity.len()];
-        self.core.motion.velocity = velocity;
-        self.core.motion.time = 0.0;
+        self.core.start_dynamics(newmark, velocity);
         Ok(())
     }
 

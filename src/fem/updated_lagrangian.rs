@@ -6,7 +6,7 @@
 
 use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
 use crate::constitutive::ConstitutiveModel;
-use crate::dynamics::{Inertia, Newmark, NewmarkStep};
+use crate::dynamics::{Inertia, Newmark, TimeStep};
 use crate::error::{require_count, InputError, StepFailure};
 use crate::kinematics::PointState;
 use crate::load_stepping::Increment;
@@ -118,7 +118,7 @@ pub(crate) struct NodalState {
     pub velocity: Vec<f64>,
     pub acceleration: Vec<f64>,
     predictor: Vec<f64>,
-    pending: Option<(NewmarkStep, f64)>,
+    pending: Option<TimeStep>,
 }
 
 impl<const D: usize> UlCore<D> {
@@ -136,48 +136,52 @@ impl<const D: usize> UlCore<D> {
         }
     }
 
-    /// The Newmark step to `load_factor` × duration and its predictor from the committed nodal
-    /// velocity and acceleration (zero at the fixed dofs), or `None` for a static step; the
-    /// load factor the loads take at that time.
-    fn prepare_motion(&mut self, num_nodes: usize, load_factor: f64) -> f64 {
+    /// Make the analysis dynamic from the nodal velocities `velocity` (node·D + axis; the
+    /// fixed dofs' taken as zero) and zero acceleration, at time 0.
+    pub fn start_dynamics(&mut self, newmark: Newmark, velocity: Vec<f64>) {
+        let m = &mut self.motion;
+        m.acceleration = vec![0.0; velocity.len()];
+        m.velocity = velocity;
+        for &(n, a) in &self.fixed_dofs {
+            m.velocity[n * D + a] = 0.0;
+        }
+        m.time = 0.0;
+        self.dynamics = Some(newmark);
+    }
+
+    /// The time step to `load_factor` × duration and its predictor from the committed nodal
+    /// velocity and acceleration (`None` for a static step); the load factor the loads take.
+    fn prepare_motion(&mut self, load_factor: f64) -> f64 {
         let Some(d) = self.dynamics else {
             self.motion.pending = None;
             return load_factor;
         };
         let m = &mut self.motion;
-        let dofs = num_nodes * D;
-        m.velocity.resize(dofs, 0.0);
-        m.acceleration.resize(dofs, 0.0);
-        for &(n, a) in &self.fixed_dofs {
-            m.velocity[n * D + a] = 0.0;
-            m.acceleration[n * D + a] = 0.0;
-        }
-        let t1 = load_factor * d.duration;
-        let step = d.step(t1 - m.time);
+        let t = d.step_to(m.time, load_factor);
         m.predictor.clear();
         m.predictor.extend(
             m.velocity
                 .iter()
                 .zip(&m.acceleration)
-                .map(|(&v, &a)| step.predictor(v, a)),
+                .map(|(&v, &a)| t.newmark.predictor(v, a)),
         );
-        m.pending = Some((step, t1));
-        d.load.factor(t1)
+        m.pending = Some(t);
+        t.load_factor
     }
 
     /// After a converged dynamic step: a₁ (N1), v₁ (N2) at every node, and the step's time.
     fn commit_motion(&mut self) {
         let m = &mut self.motion;
-        let Some((step, t1)) = m.pending.take() else {
+        let Some(t) = m.pending.take() else {
             return;
         };
-        let du = &self.work.du_nodal;
+        let (du, step) = (&self.work.du_nodal, t.newmark);
         for k in 0..m.velocity.len() {
-            let a1 = step.acceleration(du[k], m.velocity[k], m.acceleration[k]);
+            let a1 = step.acceleration_after(du[k], m.predictor[k]);
             m.velocity[k] += step.velocity_change(m.acceleration[k], a1);
             m.acceleration[k] = a1;
         }
-        m.time = t1;
+        m.time = t.end;
     }
 
     /// Build the [`StepInput`] at `load_factor` (the supports must be in `work.table`) and
@@ -190,7 +194,7 @@ impl<const D: usize> UlCore<D> {
         load_factor: f64,
         f: impl FnOnce(&mut StepWorkspace<D>, &StepInput<'_, D>) -> R,
     ) -> R {
-        let load_factor = self.prepare_motion(num_nodes, load_factor);
+        let load_factor = self.prepare_motion(load_factor);
         // Dead loads: gravity m_q g mapped with N (eq 40) and nodal forces, both ∝ load factor.
         let forces: Vec<SVector<f64, D>> = loads
             .mass
@@ -211,8 +215,8 @@ impl<const D: usize> UlCore<D> {
             point_forces: &forces,
             nodal_forces: &nodal,
             ghost: None,
-            inertia: self.motion.pending.map(|(step, _)| Inertia {
-                mass_factor: step.mass_factor(),
+            inertia: self.motion.pending.map(|t| Inertia {
+                step: t.newmark,
                 predictor: &self.motion.predictor,
                 mass: self.dynamics.map(|d| d.mass).unwrap_or_default(),
                 point_masses: loads.mass,

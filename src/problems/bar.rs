@@ -19,7 +19,7 @@ use crate::dynamics::{LoadHistory, MassMatrix, Newmark};
 use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
 use crate::grid::Grid;
-use crate::kinematics::log_strain;
+use crate::kinematics::{log_strain, PointState};
 use crate::load_stepping::{LoadStepping, StepReport};
 use crate::method::Method;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
@@ -125,9 +125,15 @@ impl BarSpec {
         (self.periods * self.steps_per_period as f64).round().max(1.0) as usize
     }
 
+    /// The simulated time, `periods` × T (the end of the last step, however the step count
+    /// was rounded).
+    pub fn duration(&self) -> f64 {
+        self.periods * self.period()
+    }
+
     fn newmark(&self) -> Newmark {
         Newmark {
-            duration: self.periods * self.period(),
+            duration: self.duration(),
             beta: self.beta,
             gamma: self.gamma,
             mass: self.mass,
@@ -176,13 +182,44 @@ impl BarSpec {
 pub fn total_energy<const D: usize>(solver: &MpmSolver<D>) -> f64 {
     let p = &solver.points;
     (0..p.len())
-        .map(|i| {
-            let kinetic = 0.5 * p.mass[i] * p.velocity[i].norm_squared();
-            let s = &p.state[i];
-            let eps = log_strain(&(s.f * s.f.transpose())).unwrap_or_else(nalgebra::Matrix3::zeros);
-            kinetic + 0.5 * s.tau.component_mul(&eps).sum() * p.volume0[i]
-        })
+        .map(|i| 0.5 * p.mass[i] * p.velocity[i].norm_squared() + strain_energy(&p.state[i], p.volume0[i]))
         .sum()
+}
+
+/// ½ τ : ε v₀ of one integration point (Hencky, ε the logarithmic strain of its F).
+fn strain_energy(s: &PointState, volume0: f64) -> f64 {
+    let eps = log_strain(&(s.f * s.f.transpose())).unwrap_or_else(nalgebra::Matrix3::zeros);
+    0.5 * s.tau.component_mul(&eps).sum() * volume0
+}
+
+/// Run `solver` to the end, recording the free end's displacement `top` and the energy
+/// `energy` at t = 0 and after every step, and finish the outcome with the final
+/// (X, u, v₀) of every integration point.
+fn run_recorded<S: LoadStepping>(
+    mut solver: S,
+    time: impl Fn(&S) -> f64,
+    top: impl Fn(&S) -> f64,
+    energy: impl Fn(&S) -> f64,
+    points: impl Fn(&S) -> Vec<[f64; 3]>,
+) -> BarOutcome {
+    let mut top_history = vec![(0.0, top(&solver))];
+    let mut energies = vec![energy(&solver)];
+    let result = solver.run_observed(&mut |s, _| {
+        top_history.push((time(s), top(s)));
+        energies.push(energy(s));
+    });
+    let (steps, failure) = match result {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    };
+    BarOutcome {
+        steps,
+        failure,
+        measured_period: period_of(&top_history),
+        top_history,
+        energy: energies,
+        points: points(&solver),
+    }
 }
 
 /// Solve one bar analysis: material point families and line elements (Line2, Line3).
@@ -235,74 +272,48 @@ pub fn fem_energy(fem: &LineFem, mass: MassMatrix) -> f64 {
             MassMatrix::Consistent => energy += 0.5 * g.mass[q] * vq * vq,
             MassMatrix::Lumped => (0..k).for_each(|a| lumped[first + a] += n[a] * g.mass[q]),
         }
-        let s = &g.state[q];
-        let eps = log_strain(&(s.f * s.f.transpose())).unwrap_or_else(nalgebra::Matrix3::zeros);
-        energy += 0.5 * s.tau.component_mul(&eps).sum() * g.volume0[q];
+        energy += strain_energy(&g.state[q], g.volume0[q]);
     }
     energy + lumped.iter().zip(v).map(|(m, v)| 0.5 * m * v * v).sum::<f64>()
 }
 
 fn solve_fem(spec: &BarSpec, element: LineElement) -> Result<BarOutcome, InputError> {
-    let mut fem = fem_solver(spec, element)?;
+    let fem = fem_solver(spec, element)?;
     let top = fem.mesh.num_nodes() - 1;
-    let mut top_history = vec![(0.0, 0.0)];
-    let mut energy = vec![fem_energy(&fem, spec.mass)];
-    let result = fem.run_observed(&mut |s, _| {
-        top_history.push((s.time(), s.displacement(top)));
-        energy.push(fem_energy(s, spec.mass));
-    });
-    let (steps, failure) = match result {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
-    let points = (0..fem.gauss.len())
-        .map(|q| {
-            let x0 = fem.gauss.position0[q];
-            [x0, fem.gauss_point_map(q).0 - x0, fem.gauss.volume0[q]]
-        })
-        .collect();
-    Ok(BarOutcome {
-        steps,
-        failure,
-        measured_period: period_of(&top_history),
-        top_history,
-        energy,
-        points,
-    })
+    Ok(run_recorded(
+        fem,
+        LineFem::time,
+        |s| s.displacement(top),
+        |s| fem_energy(s, spec.mass),
+        |s| {
+            (0..s.gauss.len())
+                .map(|q| {
+                    let x0 = s.gauss.position0[q];
+                    [x0, s.gauss_point_map(q).0 - x0, s.gauss.volume0[q]]
+                })
+                .collect()
+        },
+    ))
 }
 
 fn solve_mpm(spec: &BarSpec, method: Method) -> Result<BarOutcome, InputError> {
-    let mut solver = spec.mpm_solver(method)?;
-    let top = (0..solver.points.len())
-        .max_by(|&a, &b| solver.points.position0[a][0].total_cmp(&solver.points.position0[b][0]))
+    let solver = spec.mpm_solver(method)?;
+    let p0 = &solver.points.position0;
+    let top = (0..p0.len())
+        .max_by(|&a, &b| p0[a][0].total_cmp(&p0[b][0]))
         .expect("points");
-    let mut top_history = vec![(0.0, 0.0)];
-    let mut energy = vec![total_energy(&solver)];
-    let result = solver.run_observed(&mut |s, _| {
-        top_history.push((s.time(), s.points.position[top][0] - s.points.position0[top][0]));
-        energy.push(total_energy(s));
-    });
-    let (steps, failure) = match result {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
-    let p = &solver.points;
-    Ok(BarOutcome {
-        steps,
-        failure,
-        measured_period: period_of(&top_history),
-        top_history,
-        energy,
-        points: (0..p.len())
-            .map(|i| {
-                [
-                    p.position0[i][0],
-                    p.position[i][0] - p.position0[i][0],
-                    p.volume0[i],
-                ]
-            })
-            .collect(),
-    })
+    let u = |s: &MpmSolver<1>, i: usize| s.points.position[i][0] - s.points.position0[i][0];
+    Ok(run_recorded(
+        solver,
+        MpmSolver::time,
+        |s| u(s, top),
+        total_energy,
+        |s| {
+            (0..s.points.len())
+                .map(|i| [s.points.position0[i][0], u(s, i), s.points.volume0[i]])
+                .collect()
+        },
+    ))
 }
 
 /// The mean spacing of the downward zero crossings of u(t) (u from positive to non-positive),

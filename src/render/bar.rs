@@ -4,7 +4,7 @@
 
 use super::{checks_markdown, failures_markdown, IndexEntry};
 use crate::plot::{convergence_svg_along, profile_svg, ConvergenceSeries, ProfileSeries};
-use crate::study::bar::kind::{mass_tag, History};
+use crate::study::bar::kind::History;
 use crate::study::bar::records::BarResults;
 use crate::study::bar::{BarMeasure, FigureKind, FigureSpec, Refinement};
 use crate::study::checks::check_counts;
@@ -180,7 +180,7 @@ fn render_figure(
                         label: format!(
                             "{} ({} mass, {} el., {}/T)",
                             c.method.label(),
-                            mass_tag(c.mass),
+                            c.mass.name(),
                             c.elements,
                             c.steps_per_period
                         ),

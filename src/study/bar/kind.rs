@@ -33,8 +33,7 @@ fn solve_case(case: &BarCase) -> (BarRecord, History) {
         .count();
     solved.steps.drain(..time_steps.saturating_sub(1));
     let conv = o.as_ref().filter(|o| o.failure.is_none());
-    let exact = case.spec.period();
-    let end = case.spec.time_steps() as f64 / case.spec.steps_per_period as f64 * exact;
+    let (exact, end) = (case.spec.period(), case.spec.duration());
     let finite = |x: f64| x.is_finite().then_some(x);
     let rec = BarRecord {
         id: case.id.clone(),
@@ -109,17 +108,21 @@ impl BarStudy {
                     && sw.points_per_cell.contains(&(r.points_per_cell as i64))
                     && sw.elements.contains(&(r.elements as i64))
             };
-            let mut finest: std::collections::BTreeMap<Series, &BarRecord> = Default::default();
-            for r in records.clone().filter(in_sweep) {
-                let e = finest.entry(r.series()).or_insert(r);
-                if (r.elements, r.steps_per_period) > (e.elements, e.steps_per_period) {
-                    *e = r;
-                }
-            }
-            out.extend(finest.values().map(|r| r.id.clone()));
+            let series: BTreeSet<Series> = records.clone().filter(in_sweep).map(|r| r.series()).collect();
+            out.extend(
+                series
+                    .iter()
+                    .filter_map(|s| finest(records.clone().filter(in_sweep).filter(|r| r.series() == *s)))
+                    .map(|r| r.id.clone()),
+            );
         }
         out
     }
+}
+
+/// The finest of `cases`: most elements, then most time steps.
+fn finest<'a>(cases: impl Iterator<Item = &'a BarRecord>) -> Option<&'a BarRecord> {
+    cases.max_by_key(|c| (c.elements, c.steps_per_period))
 }
 
 /// The refined variable's step of a case: h = L / elements or Δt = T / steps per period (in
@@ -180,21 +183,6 @@ fn rates(results: &BarResults) -> Vec<RateRecord> {
     out
 }
 
-/// The finest case (most elements, then most steps) of the series of `method` and `mass` in a
-/// sweep.
-fn finest<'a>(
-    results: &'a BarResults,
-    sweep: &str,
-    method: crate::method::Method,
-    mass: crate::dynamics::MassMatrix,
-) -> Option<&'a BarRecord> {
-    results
-        .sweep(sweep)
-        .into_iter()
-        .filter(|c| c.method == method && c.mass == mass)
-        .max_by_key(|c| (c.elements, c.steps_per_period))
-}
-
 fn checks(results: &BarResults) -> Vec<CheckRecord> {
     let tier = results.provenance.tier;
     let in_tier =
@@ -215,14 +203,14 @@ fn checks(results: &BarResults) -> Vec<CheckRecord> {
                 "{}-{}-{}-{}-rate",
                 x.sweep,
                 x.method.name(),
-                mass_tag(x.mass),
+                x.mass.name(),
                 x.measure.name()
             );
             let what = format!(
                 "{} of {} ({} mass) in sweep `{}`, fitted against {} over levels {:?}",
                 x.measure.label(),
                 x.method.label(),
-                mass_tag(x.mass),
+                x.mass.name(),
                 x.sweep,
                 r.map_or("h", |r| if r.refinement == Refinement::Time {
                     "Δt"
@@ -248,19 +236,24 @@ fn checks(results: &BarResults) -> Vec<CheckRecord> {
             .iter()
             .filter(|x| in_tier(x.tier, &x.sweep))
             .map(|x| {
-                let c = finest(results, &x.sweep, x.method, x.mass);
+                let c = finest(
+                    results
+                        .sweep(&x.sweep)
+                        .into_iter()
+                        .filter(|c| c.method == x.method && c.mass == x.mass),
+                );
                 let id = format!(
                     "{}-{}-{}-{}-bound",
                     x.sweep,
                     x.method.name(),
-                    mass_tag(x.mass),
+                    x.mass.name(),
                     x.measure.name()
                 );
                 let what = format!(
                     "{} of {} ({} mass) at the finest case of sweep `{}` ({})",
                     x.measure.label(),
                     x.method.label(),
-                    mass_tag(x.mass),
+                    x.mass.name(),
                     x.sweep,
                     c.map_or("none converged".to_string(), |c| c.id.clone())
                 );
@@ -274,11 +267,4 @@ fn checks(results: &BarResults) -> Vec<CheckRecord> {
             }),
     );
     out
-}
-
-pub fn mass_tag(m: crate::dynamics::MassMatrix) -> &'static str {
-    match m {
-        crate::dynamics::MassMatrix::Consistent => "consistent",
-        crate::dynamics::MassMatrix::Lumped => "lumped",
-    }
 }
