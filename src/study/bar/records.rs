@@ -64,10 +64,7 @@ pub struct Series {
 
 impl Series {
     pub fn label(&self) -> String {
-        let mass = match self.mass {
-            MassMatrix::Consistent => "consistent",
-            MassMatrix::Lumped => "lumped",
-        };
+        let mass = self.mass.name();
         format!(
             "{} ({mass} mass, {} ppc)",
             self.method.label(),
