@@ -35,6 +35,41 @@ pub fn map_point_forces<const D: usize>(
     }
 }
 
+/// M a for a nodal field a (per nodal dof), handing each contribution (nodal dof, force) to
+/// `sink`: consistent, Σ_p m_p S_ap (Σ_b S_bp a_b); lumped, (Σ_p m_p S_ap) a_a.
+fn mass_times<const D: usize>(
+    table: &SupportTable<D>,
+    inertia: &Inertia<'_>,
+    a: impl Fn(usize) -> f64,
+    mut sink: impl FnMut(usize, f64),
+) {
+    for p in 0..table.num_points() {
+        let (nodes, s, _) = table.point(p);
+        let m = inertia.point_masses[p];
+        let mut ap = [0.0; 3];
+        if inertia.mass == MassMatrix::Consistent {
+            for (&n, &w) in nodes.iter().zip(s) {
+                for (i, v) in ap.iter_mut().enumerate().take(D) {
+                    *v += w * a(n * D + i);
+                }
+            }
+        }
+        for (&n, &w) in nodes.iter().zip(s) {
+            for (i, &v) in ap.iter().enumerate().take(D) {
+                let dof = n * D + i;
+                sink(
+                    dof,
+                    m * w
+                        * match inertia.mass {
+                            MassMatrix::Consistent => v,
+                            MassMatrix::Lumped => a(dof),
+                        },
+                );
+            }
+        }
+    }
+}
+
 /// One load step's nonlinear system over a set of integration points.
 pub struct LoadStepSystem<'a, const D: usize> {
     pub model: &'a dyn ConstitutiveModel,
@@ -57,6 +92,25 @@ pub struct LoadStepSystem<'a, const D: usize> {
     pub linearised: Option<&'a mut LinearisedReactions>,
     /// The inertia term M a₁(Δu) of a dynamic step ([`crate::dynamics`]); `None`: static.
     pub inertia: Option<Inertia<'a>>,
+    /// The scale of the convergence test of a dynamic step; `None` (static): f_ext.
+    pub dynamic_reference: Option<DynamicReference<'a>>,
+}
+
+/// What normalises the residual of a dynamic step: √(‖f_ext + M ã‖² + ‖M a₀‖²) over the free
+/// dofs. f_ext + M ã is the effective load that drives the increment (the residual at Δu = 0
+/// is f_int(u₀) − f_ext − M ã) and M a₀ the inertia force the step starts with. Either alone
+/// vanishes at instants of a motion: f_ext of a free vibration always, and of a manufactured
+/// body force at a(t) = 0 (where the static normalisation by ‖f_ext‖ made the relative residual
+/// 1e19); f_ext + M ã where 4v₀/Δt + a₀ = 0 (β = 1/4), where the vibrating bar's steps
+/// stalled at their round-off floor and were cut back, changing Δt (reference/README item 48).
+/// a₀ and ã = 4v₀/Δt + a₀ vanish together only at rest, where the scale is ‖f_ext‖ as in a
+/// static step.
+#[derive(Debug, Clone, Copy)]
+pub struct DynamicReference<'a> {
+    /// f_ext + M ã in equation order.
+    pub effective_load: &'a [f64],
+    /// ‖M a₀‖ over the free dofs.
+    pub start_inertia: f64,
 }
 
 /// The fixed rows of the tangent at the last assembly and the state they were formed at, for
@@ -163,38 +217,16 @@ impl<const D: usize> LoadStepSystem<'_, D> {
     /// f += M a₁ with a₁ = Δu/(βΔt²) − ã per nodal dof: consistent, Σ_p m_p S_ap (Σ_b S_bp a₁_b);
     /// lumped, (Σ_p m_p S_ap) a₁_a. Fixed dofs take theirs into the reactions.
     fn add_inertia_residual(&mut self, inertia: &Inertia<'_>, f_int: &mut [f64]) {
-        let a1 = |dof: usize| {
-            inertia
-                .step
-                .acceleration_after(self.du_nodal[dof], inertia.predictor[dof])
-        };
-        for p in 0..self.states.len() {
-            let (nodes, s, _) = self.table.point(p);
-            let m = inertia.point_masses[p];
-            let mut ap = [0.0; 3];
-            if inertia.mass == MassMatrix::Consistent {
-                for (&n, &w) in nodes.iter().zip(s) {
-                    for (i, a) in ap.iter_mut().enumerate().take(D) {
-                        *a += w * a1(n * D + i);
-                    }
-                }
-            }
-            for (&n, &w) in nodes.iter().zip(s) {
-                for i in 0..D {
-                    let dof = n * D + i;
-                    let f = m
-                        * w
-                        * match inertia.mass {
-                            MassMatrix::Consistent => ap[i],
-                            MassMatrix::Lumped => a1(dof),
-                        };
-                    match self.dofs.eq(dof) {
-                        Some(e) => f_int[e] += f,
-                        None => self.fixed_forces[dof] += f,
-                    }
-                }
-            }
-        }
+        let (du, dofs, fixed) = (&*self.du_nodal, self.dofs, &mut *self.fixed_forces);
+        mass_times(
+            self.table,
+            inertia,
+            |dof| inertia.step.acceleration_after(du[dof], inertia.predictor[dof]),
+            |dof, f| match dofs.eq(dof) {
+                Some(e) => f_int[e] += f,
+                None => fixed[dof] += f,
+            },
+        );
     }
 
     /// ∂S/∂x_j = ∂S/∂X̃_i (ΔF⁻¹)_ij (eq 36) and the equation numbers of point `p`'s nodes.
@@ -467,9 +499,14 @@ impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
         self.matrix.solve_in_place(rhs).map_err(StepFailure::LinearSolve)
     }
     fn reference_norm(&self, norm: ResidualNorm) -> f64 {
-        let ext: f64 = self.f_ext.iter().map(|x| x * x).sum();
+        let (load, inertia) = match self.dynamic_reference {
+            Some(d) => (d.effective_load, d.start_inertia),
+            None => (self.f_ext, 0.0),
+        };
+        let ext: f64 = load.iter().map(|x| x * x).sum::<f64>() + inertia * inertia;
         match norm {
-            ResidualNorm::External => crate::norms::l2(self.f_ext),
+            ResidualNorm::External if inertia == 0.0 => crate::norms::l2(load),
+            ResidualNorm::External => crate::norms::l2(&[crate::norms::l2(load), inertia]),
             // ‖f_ext + f_reaction‖ over all dofs: f_ext at the free dofs and, at the fixed
             // ones, f_ext + reaction = f_int of the last evaluation.
             ResidualNorm::Total => {
@@ -477,7 +514,7 @@ impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
                 if sq.is_normal() {
                     sq.sqrt()
                 } else {
-                    crate::norms::l2_of(&[self.f_ext, self.fixed_forces])
+                    crate::norms::l2_of(&[load, self.fixed_forces, &[inertia]])
                 }
             }
             // f_ext + f_rct at the fixed dofs = f_int + f^ob there.
@@ -584,6 +621,31 @@ impl<const D: usize> StepWorkspace<D> {
         }
         let mut f_ext = vec![0.0; dofs.len()];
         dofs.gather_forces(&nodal, &mut f_ext);
+        let reference = input.inertia.map(|i| {
+            let mut load = f_ext.clone();
+            let mut start = vec![0.0; dofs.len()];
+            mass_times(
+                &self.table,
+                &i,
+                |dof| i.predictor[dof],
+                |dof, f| {
+                    if let Some(e) = dofs.eq(dof) {
+                        load[e] += f;
+                    }
+                },
+            );
+            mass_times(
+                &self.table,
+                &i,
+                |dof| i.acceleration[dof],
+                |dof, f| {
+                    if let Some(e) = dofs.eq(dof) {
+                        start[e] += f;
+                    }
+                },
+            );
+            (load, crate::norms::l2(&start))
+        });
         let mut system = LoadStepSystem {
             model: input.model,
             states: input.states,
@@ -597,6 +659,10 @@ impl<const D: usize> StepWorkspace<D> {
             fixed_forces: &mut self.fixed_forces,
             linearised: track.then_some(&mut self.linearised),
             inertia: input.inertia,
+            dynamic_reference: reference.as_ref().map(|(load, start)| DynamicReference {
+                effective_load: load,
+                start_inertia: *start,
+            }),
         };
         f(&mut system)
     }

@@ -23,7 +23,9 @@
 //! element comparators keep v, a on their nodes and apply (N1)–(N2) there.
 
 use crate::error::{require_positive, InputError};
+use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// Which mass matrix the inertia term uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default, Serialize, Deserialize)]
@@ -194,6 +196,61 @@ impl NewmarkStep {
     }
 }
 
+/// A body force per unit reference volume b₀(X, t), given as a function of the reference
+/// position X and the time t: the load of a manufactured solution whose force does not
+/// factor into a fixed pattern times a load factor (b₀ = ρ₀ ẍ − Div P varies in shape with t).
+/// A solver applies it at each integration point q as b₀(X_q, t) V_q0 at the end time of each
+/// step (Newmark's trapezoidal rule balances the step's end), or, in a quasi-static analysis,
+/// with t the load factor of the step.
+#[derive(Clone)]
+pub struct BodyForce<const D: usize>(Arc<BodyForceFn<D>>);
+
+/// b₀(X, t) per unit reference volume.
+type BodyForceFn<const D: usize> = dyn Fn(&SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync;
+
+impl<const D: usize> BodyForce<D> {
+    pub fn new(f: impl Fn(&SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync + 'static) -> Self {
+        BodyForce(Arc::new(f))
+    }
+
+    /// b₀(X, t).
+    pub fn at(&self, x0: &SVector<f64, D>, t: f64) -> SVector<f64, D> {
+        (self.0)(x0, t)
+    }
+
+    /// Add b₀(X_q, t) V_q0 to each integration point's force; fails with the first point whose
+    /// force is not finite (a body force evaluated outside its domain of definition).
+    pub fn add_to(
+        &self,
+        positions0: &[SVector<f64, D>],
+        volumes0: &[f64],
+        t: f64,
+        forces: &mut [SVector<f64, D>],
+    ) -> Result<(), crate::error::StepFailure> {
+        for (q, ((x0, &v0), f)) in positions0.iter().zip(volumes0).zip(forces.iter_mut()).enumerate() {
+            let b = self.at(x0, t);
+            if b.iter().any(|v| !v.is_finite()) {
+                return Err(crate::error::StepFailure::Kinematics {
+                    point: q,
+                    reason: format!(
+                        "body force not finite at X = {:?}, t = {t:e}: {:?}",
+                        x0.as_slice(),
+                        b.as_slice()
+                    ),
+                });
+            }
+            *f += b * v0;
+        }
+        Ok(())
+    }
+}
+
+impl<const D: usize> std::fmt::Debug for BodyForce<D> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("BodyForce(b0(X, t))")
+    }
+}
+
 /// The inertia term of one step in nodal-dof order (dof = node·D + axis): the step's
 /// coefficients, the negated predictor ã (a₁ = Δu/(βΔt²) − ã), the mass matrix kind and the
 /// mass of each integration point (m_p; for the finite elements ρ₀ w det J₀ of each Gauss point).
@@ -201,6 +258,9 @@ impl NewmarkStep {
 pub struct Inertia<'a> {
     pub step: NewmarkStep,
     pub predictor: &'a [f64],
+    /// The start-of-step acceleration a₀ per nodal dof (for the scale of the convergence
+    /// test, [`crate::assembly::DynamicReference`]).
+    pub acceleration: &'a [f64],
     pub mass: MassMatrix,
     pub point_masses: &'a [f64],
 }

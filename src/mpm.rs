@@ -3,7 +3,7 @@
 use crate::assembly::{StepInput, StepWorkspace, SupportTable};
 use crate::basis::{Basis, BasisError, BasisFamily, PointSupport};
 use crate::constitutive::ConstitutiveModel;
-use crate::dynamics::{Inertia, Newmark, NewmarkStep, TimeStep};
+use crate::dynamics::{BodyForce, Inertia, Newmark, NewmarkStep, TimeStep};
 use crate::error::{require_count, InputError, StepFailure};
 use crate::ghost::{cell_fill, node_share, GhostOperator, GhostSettings};
 use crate::grid::Grid;
@@ -129,6 +129,8 @@ pub struct MpmSolver<const D: usize> {
     nodal: NodalMotion,
     /// Time of the committed state (dynamic analyses).
     time: f64,
+    /// A body force b₀(X, t) beside `loads` ([`Self::set_body_force`]).
+    body_force: Option<BodyForce<D>>,
 }
 
 /// The grid's motion at the start of a dynamic step, projected from the points, and the
@@ -205,7 +207,15 @@ impl<const D: usize> MpmSolver<D> {
             family,
             nodal: NodalMotion::default(),
             time: 0.0,
+            body_force: None,
         })
+    }
+
+    /// Load the points with a body force per unit reference volume b₀(X, t) besides `loads`:
+    /// b₀(X_p, t) V_p0 on each point, t the end time of each step (the load factor in a
+    /// quasi-static analysis).
+    pub fn set_body_force(&mut self, body_force: BodyForce<D>) {
+        self.body_force = Some(body_force);
     }
 
     /// The solver with a basis family of the caller's instead of `settings.basis`'s (e.g. one
@@ -544,6 +554,7 @@ macro_rules! step_input {
             inertia: $step.time_step.map(|t| Inertia {
                 step: t.newmark,
                 predictor: &$solver.nodal.predictor,
+                acceleration: &$solver.nodal.acceleration,
                 mass: $solver.settings.dynamics.map(|d| d.mass).unwrap_or_default(),
                 point_masses: &$solver.points.mass,
             }),
@@ -570,7 +581,11 @@ impl<const D: usize> MpmSolver<D> {
         self.build_supports()?;
         self.build_ghost();
         let time_step = self.settings.dynamics.map(|d| d.step_to(self.time, load_factor));
-        let forces = self.external_point_forces(time_step.map_or(load_factor, |t| t.load_factor));
+        let mut forces = self.external_point_forces(time_step.map_or(load_factor, |t| t.load_factor));
+        if let Some(b) = &self.body_force {
+            let t = time_step.map_or(load_factor, |t| t.end);
+            b.add_to(&self.points.position0, &self.points.volume0, t, &mut forces)?;
+        }
         let (weak, ties) = self.weak_nodes();
         let mut fixed = self.fixed.clone();
         let tied: Vec<usize> = ties.iter().map(|t| t.0).collect();

@@ -98,6 +98,7 @@ pub fn time_iteration<const D: usize>(
         fixed_forces: &mut Vec::new(),
         linearised: None,
         inertia: None,
+        dynamic_reference: None,
     };
     let u = vec![-1e-4; dofs.len()];
     let mut r = vec![0.0; dofs.len()];

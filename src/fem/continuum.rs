@@ -13,6 +13,7 @@ use super::updated_lagrangian::{
 };
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
+use crate::dynamics::{BodyForce, Newmark};
 use crate::error::{require_finite, InputError, StepFailure};
 use crate::linear::LinearSolver;
 use crate::load_stepping::{Increment, LoadStepping};
@@ -176,6 +177,94 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
     /// The constitutive model.
     pub fn model(&self) -> &dyn ConstitutiveModel {
         self.core.model.as_ref()
+    }
+
+    /// Make the analysis dynamic ([`crate::dynamics`]): the load steps become Newmark time
+    /// steps over `newmark.duration`, from the nodal velocities `velocity` and accelerations
+    /// `acceleration` (one vector per node, `None`: zero; the fixed dofs' are taken as zero) at
+    /// t = 0. The acceleration must balance the loads at t = 0 (M a₀ = f_ext(0) − f_int): a
+    /// wrong a₀ leaves an O(Δt) velocity error that costs the trapezoidal rule its order.
+    pub fn set_dynamics(
+        &mut self,
+        newmark: Newmark,
+        velocity: &[SVector<f64, D>],
+        acceleration: Option<&[SVector<f64, D>]>,
+    ) -> Result<(), InputError> {
+        newmark.validate()?;
+        if newmark.mass == crate::dynamics::MassMatrix::Lumped {
+            self.check_lumped_masses()?;
+        }
+        let nn = self.mesh.num_nodes();
+        let flat = |key: &str, v: &[SVector<f64, D>]| {
+            if v.len() != nn || v.iter().any(|v| v.iter().any(|x| !x.is_finite())) {
+                return Err(InputError::new(
+                    key,
+                    format!("{} vectors", v.len()),
+                    format!("one finite vector per node ({nn})"),
+                ));
+            }
+            Ok(v.iter().flat_map(|v| v.iter().copied()).collect::<Vec<f64>>())
+        };
+        let v = flat("initial velocity", velocity)?;
+        let a = acceleration
+            .map(|a| flat("initial acceleration", a))
+            .transpose()?;
+        self.core.start_dynamics(newmark, v, a);
+        Ok(())
+    }
+
+    /// Row-sum lumping Σ_q N_a(ξ_q) m_q must give every node of every element a positive mass:
+    /// it does for Q4 and Hex8, but the serendipity Q8 and Hex20 get negative corner masses
+    /// (−1/12 and −1/9 of an undistorted element's mass), which make the lumped mass matrix
+    /// indefinite and the analysis unstable (measured: Q8 on the dynamic manufactured vortex
+    /// inverted an element at the second step).
+    fn check_lumped_masses(&self) -> Result<(), InputError> {
+        let g = &self.gauss;
+        let k = self.mesh.element.nodes_per_element();
+        let mut lumped = vec![0.0; k];
+        for e in 0..self.mesh.num_elements() {
+            lumped.iter_mut().for_each(|m| *m = 0.0);
+            for q in (0..g.len()).filter(|&q| g.element[q] == e) {
+                let (n, _) = self.mesh.element.shape(&g.xi[q]);
+                for (m, n) in lumped.iter_mut().zip(n) {
+                    *m += n * g.mass[q];
+                }
+            }
+            if let Some(a) = lumped.iter().position(|&m| m <= 0.0) {
+                return Err(InputError::new(
+                    "dynamics.mass",
+                    "lumped",
+                    format!(
+                        "must be consistent for this element: row-sum lumping gives local node {a} of element {e} the mass {:.3e} <= 0 (serendipity Q8/Hex20 corners)",
+                        lumped[a]
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Load the Gauss points with a body force per unit reference volume b₀(X, t) besides
+    /// `loads`: b₀(X_q, t) V_q0 at each Gauss point, mapped with N_a (the consistent nodal
+    /// force of the element's quadrature), t the end time of each step (the load factor in a
+    /// quasi-static analysis).
+    pub fn set_body_force(&mut self, body_force: BodyForce<D>) {
+        self.core.body_force = Some((
+            body_force,
+            self.gauss.position0.clone(),
+            self.gauss.volume0.clone(),
+        ));
+    }
+
+    /// Nodal velocities of the committed state (node·D + axis; dynamic analyses, empty
+    /// otherwise).
+    pub fn velocity(&self) -> &[f64] {
+        &self.core.motion.velocity
+    }
+
+    /// Time of the committed state (0 for quasi-static analyses).
+    pub fn time(&self) -> f64 {
+        self.core.motion.time
     }
 
     /// Fill the support table: for each Gauss point its element's nodes, N_a(ξ_q) and

@@ -185,7 +185,7 @@ impl LineFem {
                 format!("one finite value per node ({})", self.mesh.num_nodes()),
             ));
         }
-        self.core.start_dynamics(newmark, velocity);
+        self.core.start_dynamics(newmark, velocity, None);
         Ok(())
     }
 

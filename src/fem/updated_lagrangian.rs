@@ -6,7 +6,7 @@
 
 use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
 use crate::constitutive::ConstitutiveModel;
-use crate::dynamics::{Inertia, Newmark, TimeStep};
+use crate::dynamics::{BodyForce, Inertia, Newmark, TimeStep};
 use crate::error::{require_count, InputError, StepFailure};
 use crate::kinematics::PointState;
 use crate::load_stepping::Increment;
@@ -108,6 +108,9 @@ pub(crate) struct UlCore<const D: usize> {
     /// Newmark time integration ([`crate::dynamics`]); `None`: quasi-static.
     pub dynamics: Option<Newmark>,
     pub motion: NodalState,
+    /// A body force b₀(X, t) and the Gauss points' reference positions X_q and volumes V_q0 it
+    /// is applied at (b₀(X_q, t) V_q0 mapped with N_a: the consistent nodal force).
+    pub body_force: Option<(BodyForce<D>, Vec<SVector<f64, D>>, Vec<f64>)>,
 }
 
 /// The nodes' velocity and acceleration (node·D + axis) and the time of the committed state of
@@ -133,17 +136,19 @@ impl<const D: usize> UlCore<D> {
             },
             dynamics: None,
             motion: NodalState::default(),
+            body_force: None,
         }
     }
 
-    /// Make the analysis dynamic from the nodal velocities `velocity` (node·D + axis; the
-    /// fixed dofs' taken as zero) and zero acceleration, at time 0.
-    pub fn start_dynamics(&mut self, newmark: Newmark, velocity: Vec<f64>) {
+    /// Make the analysis dynamic from the nodal velocities `velocity` and accelerations
+    /// `acceleration` (node·D + axis; `None`: zero; the fixed dofs' taken as zero) at time 0.
+    pub fn start_dynamics(&mut self, newmark: Newmark, velocity: Vec<f64>, acceleration: Option<Vec<f64>>) {
         let m = &mut self.motion;
-        m.acceleration = vec![0.0; velocity.len()];
+        m.acceleration = acceleration.unwrap_or_else(|| vec![0.0; velocity.len()]);
         m.velocity = velocity;
         for &(n, a) in &self.fixed_dofs {
             m.velocity[n * D + a] = 0.0;
+            m.acceleration[n * D + a] = 0.0;
         }
         m.time = 0.0;
         self.dynamics = Some(newmark);
@@ -185,7 +190,7 @@ impl<const D: usize> UlCore<D> {
     }
 
     /// Build the [`StepInput`] at `load_factor` (the supports must be in `work.table`) and
-    /// hand it with the workspace to `f`.
+    /// hand it with the workspace to `f`; fails if the body force is not finite.
     pub fn with_input<R>(
         &mut self,
         states: &[PointState],
@@ -193,14 +198,16 @@ impl<const D: usize> UlCore<D> {
         loads: &FullLoads<'_, D>,
         load_factor: f64,
         f: impl FnOnce(&mut StepWorkspace<D>, &StepInput<'_, D>) -> R,
-    ) -> R {
-        let load_factor = self.prepare_motion(load_factor);
+    ) -> Result<R, StepFailure> {
+        let factor = self.prepare_motion(load_factor);
         // Dead loads: gravity m_q g mapped with N (eq 40) and nodal forces, both ∝ load factor.
-        let forces: Vec<SVector<f64, D>> = loads
-            .mass
-            .iter()
-            .map(|&m| loads.gravity * (m * load_factor))
-            .collect();
+        let mut forces: Vec<SVector<f64, D>> =
+            loads.mass.iter().map(|&m| loads.gravity * (m * factor)).collect();
+        if let Some((b, x0, v0)) = &self.body_force {
+            let t = self.motion.pending.map_or(load_factor, |t| t.end);
+            b.add_to(x0, v0, t, &mut forces)?;
+        }
+        let load_factor = factor;
         let nodal: Vec<(usize, f64)> = loads
             .dof_forces
             .iter()
@@ -218,11 +225,12 @@ impl<const D: usize> UlCore<D> {
             inertia: self.motion.pending.map(|t| Inertia {
                 step: t.newmark,
                 predictor: &self.motion.predictor,
+                acceleration: &self.motion.acceleration,
                 mass: self.dynamics.map(|d| d.mass).unwrap_or_default(),
                 point_masses: loads.mass,
             }),
         };
-        f(&mut self.work, &input)
+        Ok(f(&mut self.work, &input))
     }
 
     /// Solve and commit one increment to the total load factor `load_factor` (the ramp of
@@ -244,9 +252,11 @@ impl<const D: usize> UlCore<D> {
         })
         .map_err(|f| (f, vec![]))?;
         let before = self.work.matrix.stats().iterations;
-        let report = self.with_input(states, num_nodes, loads, load_factor, |work, input| {
-            work.solve(input, newton)
-        })?;
+        let report = self
+            .with_input(states, num_nodes, loads, load_factor, |work, input| {
+                work.solve(input, newton)
+            })
+            .map_err(|f| (f, vec![]))??;
         for (state, new) in states.iter_mut().zip(self.work.committed_states()) {
             *state = new;
         }
@@ -328,11 +338,11 @@ pub(crate) fn fem_step_system<const D: usize, M: FemMesh<D>, R>(
         mass: &gauss.mass,
         dof_forces,
     };
-    Ok(core.with_input(
+    core.with_input(
         &gauss.state,
         mesh.num_nodes(),
         &loads,
         load_factor,
         |work, input| work.with_system(input, f),
-    ))
+    )
 }

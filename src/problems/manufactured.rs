@@ -550,8 +550,13 @@ fn solve_mpm(spec: &ManufacturedSpec, method: Method) -> Result<Run, InputError>
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
     };
+    Ok((steps, failure, mpm_point_values(&solver)))
+}
+
+/// The material points of a plane solver as the error measures and point files take them.
+pub(crate) fn mpm_point_values(solver: &MpmSolver<2>) -> Vec<PointValue> {
     let p = &solver.points;
-    let values = (0..p.len())
+    (0..p.len())
         .map(|i| PointValue {
             x0: [p.position0[i][0], p.position0[i][1]],
             x: [p.position[i][0], p.position[i][1]],
@@ -559,8 +564,7 @@ fn solve_mpm(spec: &ManufacturedSpec, method: Method) -> Result<Run, InputError>
             sigma: sigma4(&p.state[i].cauchy()),
             half: [p.half_length[i][0], p.half_length[i][1]],
         })
-        .collect();
-    Ok((steps, failure, values))
+        .collect()
 }
 
 /// The Q4 (`fem-q4`) or Q8 (`fem-q8`) solver of `spec`: the unit square meshed by its cells,
@@ -619,7 +623,12 @@ fn solve_fem(spec: &ManufacturedSpec, method: Method) -> Result<Run, InputError>
         Ok(s) => (s, None),
         Err((s, e)) => (s, Some(e)),
     };
-    let values = (0..fem.gauss.len())
+    Ok((steps, failure, fem_point_values(&fem)))
+}
+
+/// The Gauss points of a plane FEM solver as the error measures and point files take them.
+pub(crate) fn fem_point_values(fem: &PlaneFem) -> Vec<PointValue> {
+    (0..fem.gauss.len())
         .map(|g| {
             let x = fem.gauss_point_position(g);
             PointValue {
@@ -630,6 +639,5 @@ fn solve_fem(spec: &ManufacturedSpec, method: Method) -> Result<Run, InputError>
                 half: [0.0, 0.0],
             }
         })
-        .collect();
-    Ok((steps, failure, values))
+        .collect()
 }

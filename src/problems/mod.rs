@@ -8,3 +8,4 @@ pub mod compaction;
 pub mod elastica;
 pub mod manufactured;
 pub mod manufactured3d;
+pub mod manufactured_dynamic;

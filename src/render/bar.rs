@@ -51,14 +51,14 @@ pub fn report_markdown(results: &BarResults, not_drawn: &[super::NotDrawn]) -> S
         }
         let _ = writeln!(
             s,
-            "## {}\n\n{}\n\n| case | elements | steps per period | displacement | period | period error | energy | Newton iterations (most per step) | steps at round-off floor |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+            "## {}\n\n{}\n\n| case | elements | steps per period | displacement | period | period error | energy | Newton iterations (most per step) | steps at round-off floor | steps cut back |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
             sw.id, sw.title
         );
         for ser in results.sweep_series(&sw.id) {
             for c in results.series_cases(&sw.id, &ser) {
                 let _ = writeln!(
                     s,
-                    "| {} | {} | {} | {} | {} | {} | {} | {} ({}) | {} |",
+                    "| {} | {} | {} | {} | {} | {} | {} | {} ({}) | {} | {} |",
                     c.id,
                     c.elements,
                     c.steps_per_period,
@@ -68,7 +68,8 @@ pub fn report_markdown(results: &BarResults, not_drawn: &[super::NotDrawn]) -> S
                     e3(c.energy_drift),
                     c.solve.newton_iterations,
                     c.max_newton_iterations,
-                    c.steps_at_floor
+                    c.steps_at_floor,
+                    c.steps_cut_back
                 );
             }
         }

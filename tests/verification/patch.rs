@@ -68,6 +68,7 @@ fn patch<const D: usize>(
         fixed_forces: &mut Vec::new(),
         linearised: None,
         inertia: None,
+        dynamic_reference: None,
     };
     let mut r = vec![0.0; dofs.len()];
     sys.evaluate(&u, &mut r).unwrap();

@@ -130,6 +130,7 @@ fn tangent_error_with<const D: usize>(
         fixed_forces: &mut Vec::new(),
         linearised: None,
         inertia: None,
+        dynamic_reference: None,
     };
     let mut r0 = vec![0.0; n];
     sys.evaluate(&u0, &mut r0).unwrap();

@@ -31,6 +31,9 @@ fn solve_case(case: &BarCase) -> (BarRecord, History) {
         .iter()
         .filter(|s| s.accepted_at_floor.is_some())
         .count();
+    let steps_cut_back = o
+        .as_ref()
+        .map_or(0, |o| o.steps.iter().filter(|s| s.cutbacks() > 0).count());
     solved.steps.drain(..time_steps.saturating_sub(1));
     let conv = o.as_ref().filter(|o| o.failure.is_none());
     let (exact, end) = (case.spec.period(), case.spec.duration());
@@ -46,6 +49,7 @@ fn solve_case(case: &BarCase) -> (BarRecord, History) {
         time_steps,
         max_newton_iterations,
         steps_at_floor,
+        steps_cut_back,
         displacement_error: conv.and_then(|o| finite(o.displacement_error(&case.spec, end))),
         measured_period: conv.and_then(|o| o.measured_period),
         period_error: conv

@@ -26,6 +26,11 @@ pub struct BarRecord {
     pub max_newton_iterations: usize,
     /// Time steps accepted at their round-off floor (none silently: listed here by count).
     pub steps_at_floor: usize,
+    /// Time steps whose increment Newton could not take at once and the load stepping cut
+    /// (their Δt is smaller than the nominal one, so a convergence series with any is not at
+    /// uniform Δt); absent in results written before they were counted.
+    #[serde(default)]
+    pub steps_cut_back: usize,
     /// Converged cases only.
     pub displacement_error: Option<f64>,
     /// The period measured from the free end's zero crossings, and its relative error.
