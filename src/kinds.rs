@@ -5,10 +5,10 @@
 //! (`src/render/<x>.rs`) and one line in [`KINDS`].
 
 use crate::render::{self, IndexEntry, Rendered};
-use crate::study::bar::BarStudy;
 use crate::study::cantilever::CantileverStudy;
 use crate::study::column::ColumnStudy;
 use crate::study::compaction::CompactionStudy;
+use crate::study::dynamics::DynamicStudy;
 use crate::study::engine::{self, RunOptions, StudyKind};
 use crate::study::manufactured::ManufacturedStudy;
 use crate::study::results::{problem_of_results, problem_of_study, RunSummary};
@@ -21,7 +21,7 @@ pub const KINDS: &[Kind] = &[
     Kind::of::<CompactionStudy>(render::compaction::render, render::compaction::index_entry),
     Kind::of::<CantileverStudy>(render::cantilever::render, render::cantilever::index_entry),
     Kind::of::<ManufacturedStudy>(render::manufactured::render, render::manufactured::index_entry),
-    Kind::of::<BarStudy>(render::bar::render, render::bar::index_entry),
+    Kind::of::<DynamicStudy>(render::dynamics::render, render::dynamics::index_entry),
 ];
 
 /// What `study` asks of one study file.
@@ -89,8 +89,17 @@ fn run_kind<K: StudyKind>(
     Ok((dir, Some(run.results.summary(run.resumed))))
 }
 
+/// Problem keys of results written before a kind was renamed, and the kind's key now: the
+/// dynamics kind was "bar" while the vibrating bar was its only problem, so that such a
+/// results folder still renders (a study file must name the kind's key).
+const RENAMED: &[(&str, &str)] = &[("bar", "dynamics")];
+
 /// The kind of `problem`, or an error naming the study file's `problem` key and the kinds.
 pub fn kind(problem: &str, shown: &str) -> Result<&'static Kind, StudyError> {
+    let problem = RENAMED
+        .iter()
+        .find(|(old, _)| *old == problem)
+        .map_or(problem, |(_, new)| new);
     KINDS.iter().find(|k| k.problem == problem).ok_or_else(|| {
         let known: Vec<&str> = KINDS.iter().map(|k| k.problem).collect();
         StudyError::Invalid {

@@ -3,10 +3,10 @@
 //! Markdown and index helpers here. Nothing here solves: every module imports the results
 //! types only ([`crate::study`]'s records, envelopes and study files).
 
-pub mod bar;
 pub mod cantilever;
 pub mod column;
 pub mod compaction;
+pub mod dynamics;
 pub mod manufactured;
 pub mod methods;
 

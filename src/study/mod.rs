@@ -12,11 +12,11 @@
 //! Counts in the files are parsed as signed integers so that a negative value is reported by
 //! validation with its key and allowed range instead of as a type error.
 
-pub mod bar;
 pub mod cantilever;
 pub mod checks;
 pub mod column;
 pub mod compaction;
+pub mod dynamics;
 pub mod engine;
 pub mod manufactured;
 pub mod methods;

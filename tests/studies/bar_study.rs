@@ -3,20 +3,20 @@
 //! second order in h, the period within 0.5 %, the energy bounded), the outputs re-render byte
 //! for byte, and the time-rate band fails for a damped Newmark (γ = 0.6: first order).
 
-use igimp::render::bar::render;
-use igimp::study::bar::BarStudy;
+use igimp::render::dynamics::render;
+use igimp::study::dynamics::DynamicStudy;
 use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
 use igimp::study::Tier;
 use std::path::Path;
 use std::sync::OnceLock;
 
-fn study() -> BarStudy {
-    BarStudy::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/vibrating-bar.toml"))
+fn study() -> DynamicStudy {
+    DynamicStudy::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/vibrating-bar.toml"))
         .expect("studies/vibrating-bar.toml parses")
 }
 
-fn quick() -> &'static Run<BarStudy> {
-    static RUN: OnceLock<Run<BarStudy>> = OnceLock::new();
+fn quick() -> &'static Run<DynamicStudy> {
+    static RUN: OnceLock<Run<DynamicStudy>> = OnceLock::new();
     RUN.get_or_init(|| run_in_memory(&study(), "vibrating-bar.toml", Tier::Quick).expect("an in-memory run"))
 }
 
@@ -69,8 +69,9 @@ fn bar_outputs_rerender_byte_identically() {
 #[test]
 fn damped_newmark_fails_the_time_rate_band() {
     let mut s = study();
-    s.bar.gamma = 0.6;
-    s.bar.beta = 0.3025; // (γ + 1/2)² / 4: unconditionally stable with γ = 0.6
+    let b = s.bar.as_mut().expect("the bar study has [bar]");
+    b.gamma = 0.6;
+    b.beta = 0.3025; // (γ + 1/2)² / 4: unconditionally stable with γ = 0.6
     s.sweeps.retain(|x| x.id == "time");
     s.expect_rate.retain(|x| x.sweep == "time");
     s.expect_at_most.clear();

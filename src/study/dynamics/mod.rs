@@ -1,9 +1,11 @@
-//! The vibrating-bar study kind (implicit dynamics): `studies/vibrating-bar.toml` →
-//! `results.json` → `report.md` and its figures. A sweep is methods × mass matrices ×
-//! elements × points per cell × time steps per period, with either the elements (space
-//! convergence at a small Δt) or the time steps (time convergence on a fine grid) varied; each
-//! series gets a rate fitted against h or Δt, and `[[expect_rate]]` / `[[expect_at_most]]` turn
-//! rates, period errors and energy drifts into checks.
+//! The dynamics study kind (implicit dynamics, `problem = "dynamics"`): a study file of one
+//! dynamic problem, the vibrating bar (`[bar]`, `studies/vibrating-bar.toml`) or the dynamic
+//! manufactured fields (`[manufactured]`, `studies/manufactured-dynamic.toml`) → `results.json`
+//! → `report.md` and its figures. A sweep is methods × mass matrices × elements (cells) ×
+//! points per cell × time steps per period, with either the elements (space convergence at a
+//! small Δt) or the time steps (time convergence on a fine grid) varied; each series gets a
+//! rate fitted against h or Δt, and `[[expect_rate]]` / `[[expect_at_most]]` turn rates, errors,
+//! periods and energy drifts into checks.
 
 pub mod kind;
 pub mod records;
@@ -13,6 +15,8 @@ use super::{StudyError, Tier};
 use crate::dynamics::MassMatrix;
 use crate::method::Method;
 use crate::problems::bar::BarSpec;
+use crate::problems::manufactured::Field;
+use crate::problems::manufactured_dynamic::{self, DynamicManufacturedSpec};
 use crate::study::engine::distinct_cases;
 use crate::study::results::SweepIndex;
 use serde::{Deserialize, Serialize};
@@ -30,6 +34,25 @@ pub struct BarSection {
     /// Simulated time in periods T = 4L/c.
     pub periods: f64,
     /// Newmark β, γ (default 1/4, 1/2: the trapezoidal rule).
+    #[serde(default = "quarter")]
+    pub beta: f64,
+    #[serde(default = "half")]
+    pub gamma: f64,
+}
+
+/// The dynamic manufactured fields of every case
+/// ([`crate::problems::manufactured_dynamic`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ManufacturedSection {
+    pub young_modulus: f64,
+    pub poisson_ratio: f64,
+    /// ρ₀.
+    pub density: f64,
+    /// Peak amplitude of each field (A of the axis-aligned field, θ₀ of the vortex).
+    pub amplitude: crate::study::manufactured::AmplitudeSection,
+    /// Simulated time in periods T = 2/c of the forcing.
+    pub periods: f64,
     #[serde(default = "quarter")]
     pub beta: f64,
     #[serde(default = "half")]
@@ -61,9 +84,12 @@ pub struct SweepQuick {
 /// One sweep: the lists' product, one of `elements` and `steps_per_period` varied.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct BarSweep {
+pub struct DynamicSweep {
     pub id: String,
     pub title: String,
+    /// The manufactured field (manufactured studies only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub field: Option<Field>,
     pub methods: Vec<Method>,
     #[serde(default = "consistent")]
     pub mass: Vec<MassMatrix>,
@@ -78,7 +104,7 @@ fn consistent() -> Vec<MassMatrix> {
     vec![MassMatrix::Consistent]
 }
 
-impl super::vocabulary::TieredSweep for BarSweep {
+impl super::vocabulary::TieredSweep for DynamicSweep {
     fn id(&self) -> &str {
         &self.id
     }
@@ -100,29 +126,38 @@ pub enum Refinement {
 /// A measure of a case.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum BarMeasure {
+pub enum DynamicMeasure {
     /// ‖u_h − u‖ / ‖u‖ over the points at the end.
     Displacement,
+    /// The stress error of the form of eq (46) at the end (manufactured fields).
+    Stress,
     /// |T_h − T| / T, T_h from the free end's zero crossings.
     Period,
     /// max_t |E(t) − E(0)| / E(0).
     Energy,
 }
 
-impl BarMeasure {
-    pub const ALL: [BarMeasure; 3] = [BarMeasure::Displacement, BarMeasure::Period, BarMeasure::Energy];
+impl DynamicMeasure {
+    pub const ALL: [DynamicMeasure; 4] = [
+        DynamicMeasure::Displacement,
+        DynamicMeasure::Stress,
+        DynamicMeasure::Period,
+        DynamicMeasure::Energy,
+    ];
     pub fn name(self) -> &'static str {
         match self {
-            BarMeasure::Displacement => "displacement",
-            BarMeasure::Period => "period",
-            BarMeasure::Energy => "energy",
+            DynamicMeasure::Displacement => "displacement",
+            DynamicMeasure::Stress => "stress",
+            DynamicMeasure::Period => "period",
+            DynamicMeasure::Energy => "energy",
         }
     }
     pub fn label(self) -> &'static str {
         match self {
-            BarMeasure::Displacement => "relative L2 displacement error at the end",
-            BarMeasure::Period => "relative period error",
-            BarMeasure::Energy => "largest relative energy change",
+            DynamicMeasure::Displacement => "relative L2 displacement error at the end",
+            DynamicMeasure::Stress => "stress error at the end, form of eq (46)",
+            DynamicMeasure::Period => "relative period error",
+            DynamicMeasure::Energy => "largest relative energy change",
         }
     }
 }
@@ -135,7 +170,7 @@ pub struct RateExpectation {
     pub method: Method,
     #[serde(default)]
     pub mass: MassMatrix,
-    pub measure: BarMeasure,
+    pub measure: DynamicMeasure,
     pub rate: f64,
     pub tolerance: f64,
     /// Only in this tier; absent: both.
@@ -153,7 +188,7 @@ pub struct BoundExpectation {
     pub method: Method,
     #[serde(default)]
     pub mass: MassMatrix,
-    pub measure: BarMeasure,
+    pub measure: DynamicMeasure,
     pub limit: f64,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tier: Option<Tier>,
@@ -179,7 +214,7 @@ pub struct FigureSpec {
     pub sweep: String,
     /// Convergence figures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub measure: Option<BarMeasure>,
+    pub measure: Option<DynamicMeasure>,
 }
 
 impl super::vocabulary::SweepFigure for FigureSpec {
@@ -188,19 +223,23 @@ impl super::vocabulary::SweepFigure for FigureSpec {
     }
 }
 
-/// `studies/vibrating-bar.toml`.
+/// A dynamics study file (`studies/vibrating-bar.toml`, `studies/manufactured-dynamic.toml`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct BarStudy {
+pub struct DynamicStudy {
     pub schema: i64,
     pub name: String,
     pub summary: String,
-    /// Always "bar".
+    /// Always "dynamics" ("bar" in files written before the kind had a second problem).
     pub problem: String,
     pub report_file: String,
-    pub bar: BarSection,
+    /// The vibrating bar; exactly one of `bar` and `manufactured` is given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bar: Option<BarSection>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub manufactured: Option<ManufacturedSection>,
     pub newton: NewtonSection,
-    pub sweeps: Vec<BarSweep>,
+    pub sweeps: Vec<DynamicSweep>,
     #[serde(default)]
     pub expect_rate: Vec<RateExpectation>,
     #[serde(default)]
@@ -211,10 +250,46 @@ pub struct BarStudy {
 
 /// One case to solve.
 #[derive(Debug, Clone, PartialEq)]
-pub struct BarCase {
+pub struct DynamicCase {
     pub id: String,
     pub method: Method,
-    pub spec: BarSpec,
+    pub spec: CaseSpec,
+}
+
+/// The problem input of one case. Serialised untagged, so that a bar case's key (a hash of
+/// its spec) is what it was before the kind had a second problem.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum CaseSpec {
+    Bar(BarSpec),
+    Manufactured(DynamicManufacturedSpec),
+}
+
+impl CaseSpec {
+    pub fn validate(&self) -> Result<(), crate::error::InputError> {
+        match self {
+            CaseSpec::Bar(b) => b.validate(),
+            CaseSpec::Manufactured(m) => m.validate(),
+        }
+    }
+
+    /// Points (or Gauss points) × time steps: the planner's cost.
+    pub fn cost(&self) -> f64 {
+        match self {
+            CaseSpec::Bar(b) => (b.elements * b.points_per_cell * b.time_steps()) as f64,
+            CaseSpec::Manufactured(m) => {
+                (m.cells * m.cells * m.points_per_cell * m.points_per_cell * m.time_steps()) as f64
+            }
+        }
+    }
+
+    /// The period of the motion: the bar's 4L/c, the manufactured forcing's 2/c.
+    pub fn period(&self) -> f64 {
+        match self {
+            CaseSpec::Bar(b) => b.period(),
+            CaseSpec::Manufactured(m) => m.period(),
+        }
+    }
 }
 
 /// The sweep's lists after the tier's overrides.
@@ -236,12 +311,15 @@ pub const BAR_METHODS: [Method; 8] = [
     Method::FEM_QUADRATIC,
 ];
 
+/// The methods of a manufactured case: every material point family, Q4 and Q8.
+pub const MANUFACTURED_METHODS: [Method; 8] = manufactured_dynamic::METHODS;
+
 /// Most elements of one case (1D: cheap; a bound against typos).
 const MAX_ELEMENTS: i64 = 65_536;
 /// Most time steps per period.
 const MAX_STEPS_PER_PERIOD: i64 = 65_536;
 
-impl BarSweep {
+impl DynamicSweep {
     fn plan(&self, tier: Tier) -> Option<SweepPlan> {
         if !super::vocabulary::TieredSweep::runs_in(self, tier) {
             return None;
@@ -271,14 +349,20 @@ impl BarSweep {
     }
 }
 
-impl BarStudy {
-    pub fn sweep(&self, id: &str) -> Option<&BarSweep> {
+impl DynamicStudy {
+    pub fn sweep(&self, id: &str) -> Option<&DynamicSweep> {
         self.sweeps.iter().find(|s| s.id == id)
     }
 
-    /// The spec of one case.
-    pub fn case_spec(&self, mass: MassMatrix, elements: i64, ppc: i64, steps: i64) -> BarSpec {
-        let b = &self.bar;
+    /// The bar's spec of one case.
+    pub fn bar_spec(
+        b: &BarSection,
+        newton: &NewtonSection,
+        mass: MassMatrix,
+        elements: i64,
+        ppc: i64,
+        steps: i64,
+    ) -> BarSpec {
         BarSpec {
             length: b.length,
             young_modulus: b.young_modulus,
@@ -291,34 +375,93 @@ impl BarStudy {
             beta: b.beta,
             gamma: b.gamma,
             mass,
-            newton: self.newton.settings(),
+            newton: newton.settings(),
         }
     }
 
-    /// `<method>-<mass>-e<elements>-p<ppc>-n<steps per period>`.
-    pub fn case_id(method: Method, spec: &BarSpec) -> String {
-        let mass = match spec.mass {
+    /// The spec of one case of `sweep` (`None`: the file gives neither problem section, or a
+    /// manufactured sweep without its field; validation reports both).
+    pub fn case_spec(
+        &self,
+        sweep: &DynamicSweep,
+        mass: MassMatrix,
+        elements: i64,
+        ppc: i64,
+        steps: i64,
+    ) -> Option<CaseSpec> {
+        if let Some(b) = &self.bar {
+            return Some(CaseSpec::Bar(Self::bar_spec(
+                b,
+                &self.newton,
+                mass,
+                elements,
+                ppc,
+                steps,
+            )));
+        }
+        let m = self.manufactured.as_ref()?;
+        let field = sweep.field?;
+        Some(CaseSpec::Manufactured(DynamicManufacturedSpec {
+            field,
+            amplitude: match field {
+                Field::AxisAligned => m.amplitude.axis_aligned,
+                Field::Vortex => m.amplitude.vortex,
+            },
+            young_modulus: m.young_modulus,
+            poisson_ratio: m.poisson_ratio,
+            density: m.density,
+            cells: elements as usize,
+            points_per_cell: ppc as usize,
+            steps_per_period: steps as usize,
+            periods: m.periods,
+            beta: m.beta,
+            gamma: m.gamma,
+            mass,
+            newton: self.newton.settings(),
+            domain_update: Default::default(),
+        }))
+    }
+
+    /// `<method>[-<field>]-<mass>-e<elements>-p<ppc>-n<steps per period>`.
+    pub fn case_id(method: Method, spec: &CaseSpec) -> String {
+        let (field, mass, elements, ppc, steps) = match spec {
+            CaseSpec::Bar(b) => (None, b.mass, b.elements, b.points_per_cell, b.steps_per_period),
+            CaseSpec::Manufactured(m) => (
+                Some(m.field),
+                m.mass,
+                m.cells,
+                m.points_per_cell,
+                m.steps_per_period,
+            ),
+        };
+        let mass = match mass {
             MassMatrix::Consistent => "cm",
             MassMatrix::Lumped => "lm",
         };
-        format!(
-            "{}-{mass}-e{}-p{}-n{}",
-            method.name(),
-            spec.elements,
-            spec.points_per_cell,
-            spec.steps_per_period
-        )
+        let field = field.map_or(String::new(), |f| format!("-{}", f.name()));
+        format!("{}{field}-{mass}-e{elements}-p{ppc}-n{steps}", method.name())
     }
 
-    fn sweep_cases(&self, s: &BarSweep, plan: &SweepPlan) -> Vec<BarCase> {
+    /// The methods a case of this study may use.
+    pub fn methods(&self) -> &'static [Method] {
+        if self.bar.is_some() {
+            &BAR_METHODS
+        } else {
+            &MANUFACTURED_METHODS
+        }
+    }
+
+    fn sweep_cases(&self, s: &DynamicSweep, plan: &SweepPlan) -> Vec<DynamicCase> {
         let mut out = vec![];
         for &method in &plan.methods {
             for &mass in &s.mass {
                 for &ppc in &s.points_per_cell {
                     for &e in &plan.elements {
                         for &n in &plan.steps_per_period {
-                            let spec = self.case_spec(mass, e, ppc, n);
-                            out.push(BarCase {
+                            let Some(spec) = self.case_spec(s, mass, e, ppc, n) else {
+                                continue;
+                            };
+                            out.push(DynamicCase {
                                 id: Self::case_id(method, &spec),
                                 method,
                                 spec,
@@ -331,7 +474,7 @@ impl BarStudy {
         out
     }
 
-    pub fn cases(&self, tier: Tier) -> (Vec<BarCase>, SweepIndex) {
+    pub fn cases(&self, tier: Tier) -> (Vec<DynamicCase>, SweepIndex) {
         distinct_cases(
             self.sweeps
                 .iter()
@@ -345,35 +488,75 @@ impl BarStudy {
         chk.header(Header {
             schema: self.schema,
             problem: &self.problem,
-            expected_problem: "bar",
+            expected_problem: "dynamics",
             name: &self.name,
             summary: &self.summary,
             report_file: &self.report_file,
         })?;
         chk.newton("newton", &self.newton)?;
-        let b = &self.bar;
-        for (k, v) in [
-            ("bar.length", b.length),
-            ("bar.young_modulus", b.young_modulus),
-            ("bar.density", b.density),
-            ("bar.velocity", b.velocity),
-            ("bar.periods", b.periods),
-        ] {
-            chk.positive(k, v)?;
-        }
-        // The period is measured from zero crossings: at least two need 1.5 periods.
-        if b.periods < 1.5 {
-            return Err(chk.err(
-                "bar.periods",
-                b.periods,
-                "must be >= 1.5 (two zero crossings of the free end)",
-            ));
+        match (&self.bar, &self.manufactured) {
+            (Some(b), None) => {
+                for (k, v) in [
+                    ("bar.length", b.length),
+                    ("bar.young_modulus", b.young_modulus),
+                    ("bar.density", b.density),
+                    ("bar.velocity", b.velocity),
+                    ("bar.periods", b.periods),
+                ] {
+                    chk.positive(k, v)?;
+                }
+                // The period is measured from zero crossings: at least two need 1.5 periods.
+                if b.periods < 1.5 {
+                    return Err(chk.err(
+                        "bar.periods",
+                        b.periods,
+                        "must be >= 1.5 (two zero crossings of the free end)",
+                    ));
+                }
+            }
+            (None, Some(m)) => {
+                for (k, v) in [
+                    ("manufactured.young_modulus", m.young_modulus),
+                    ("manufactured.density", m.density),
+                    ("manufactured.periods", m.periods),
+                ] {
+                    chk.positive(k, v)?;
+                }
+            }
+            (b, _) => {
+                return Err(chk.err(
+                    if b.is_some() { "manufactured" } else { "bar" },
+                    if b.is_some() {
+                        "(both given)"
+                    } else {
+                        "(neither given)"
+                    },
+                    "exactly one of [bar] and [manufactured] must define the problem",
+                ))
+            }
         }
         chk.non_empty("sweeps", &self.sweeps)?;
         let mut ids = BTreeSet::new();
         for (i, s) in self.sweeps.iter().enumerate() {
             chk.unique_ident(&format!("sweeps[{i}].id"), &s.id, &mut ids)?;
             chk.text(&format!("sweeps[{i}].title"), &s.title)?;
+            match (self.manufactured.is_some(), s.field) {
+                (true, None) => {
+                    return Err(chk.err(
+                        format!("sweeps[{i}].field"),
+                        "(missing)",
+                        "is required with [manufactured]: axis-aligned or vortex",
+                    ))
+                }
+                (false, Some(f)) => {
+                    return Err(chk.err(
+                        format!("sweeps[{i}].field"),
+                        f.name(),
+                        "must be absent for the bar",
+                    ))
+                }
+                _ => {}
+            }
             chk.non_empty(&format!("sweeps[{i}].mass"), &s.mass)?;
             chk.non_empty(&format!("sweeps[{i}].points_per_cell"), &s.points_per_cell)?;
             for (j, &p) in s.points_per_cell.iter().enumerate() {
@@ -391,8 +574,15 @@ impl BarStudy {
                 chk.non_empty(&k("elements"), &plan.elements)?;
                 chk.non_empty(&k("steps_per_period"), &plan.steps_per_period)?;
                 for (j, m) in plan.methods.iter().enumerate() {
-                    m.expect_one_of("bar", &BAR_METHODS)
-                        .map_err(|e| chk.err(k(&format!("methods[{j}]")), m.name(), e.allowed))?;
+                    m.expect_one_of(
+                        if self.bar.is_some() {
+                            "bar"
+                        } else {
+                            "dynamic manufactured"
+                        },
+                        self.methods(),
+                    )
+                    .map_err(|e| chk.err(k(&format!("methods[{j}]")), m.name(), e.allowed))?;
                 }
                 for (j, &n) in plan.elements.iter().enumerate() {
                     chk.count(&k(&format!("elements[{j}]")), n, 1, MAX_ELEMENTS)?;
@@ -420,11 +610,11 @@ impl BarStudy {
                 }
             }
         }
-        let sweep = |key: String, id: &str| -> Result<&BarSweep, StudyError> {
+        let sweep = |key: String, id: &str| -> Result<&DynamicSweep, StudyError> {
             self.sweep(id)
                 .ok_or_else(|| chk.err(key, id, "must name a sweep"))
         };
-        let method_and_mass = |k: &dyn Fn(&str) -> String, s: &BarSweep, m: Method, mass: MassMatrix| {
+        let method_and_mass = |k: &dyn Fn(&str) -> String, s: &DynamicSweep, m: Method, mass: MassMatrix| {
             if !s.methods.contains(&m) {
                 return Err(chk.err(
                     k("method"),
@@ -468,6 +658,9 @@ impl BarStudy {
                 (FigureKind::History, Some(m)) => {
                     return Err(chk.err(k("measure"), m.name(), "must be absent for history figures"))
                 }
+                (FigureKind::History, None) if self.bar.is_none() => {
+                    return Err(chk.err(k("kind"), "history", "is drawn for the bar only"))
+                }
                 _ => {}
             }
         }
@@ -475,7 +668,7 @@ impl BarStudy {
             for c in self.cases(tier).0 {
                 c.spec
                     .validate()
-                    .map_err(|e| chk.err(format!("case {}", c.id), e, "must be a valid bar input"))?;
+                    .map_err(|e| chk.err(format!("case {}", c.id), e, "must be a valid dynamic input"))?;
             }
         }
         Ok(())

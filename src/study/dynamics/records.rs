@@ -1,7 +1,7 @@
-//! What a vibrating-bar study's `results.json` holds besides the envelope: the case records
-//! (error, period, energy) and the fitted rates.
+//! What a dynamics study's `results.json` holds besides the envelope: the case records
+//! (errors; the bar's period and energy) and the fitted rates.
 
-use super::{BarMeasure, BarStudy, Refinement};
+use super::{DynamicMeasure, DynamicStudy, Refinement};
 use crate::dynamics::MassMatrix;
 use crate::method::Method;
 use crate::study::results::{case_record, Envelope, SolveRecord};
@@ -9,9 +9,12 @@ use serde::{Deserialize, Serialize};
 
 /// Result of one case.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BarRecord {
+pub struct DynamicRecord {
     pub id: String,
     pub method: Method,
+    /// The manufactured field (manufactured studies).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub field: Option<crate::problems::manufactured::Field>,
     pub mass: MassMatrix,
     pub elements: usize,
     pub points_per_cell: usize,
@@ -33,6 +36,9 @@ pub struct BarRecord {
     pub steps_cut_back: usize,
     /// Converged cases only.
     pub displacement_error: Option<f64>,
+    /// The stress error at the end (manufactured fields; the bar has none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stress_error: Option<f64>,
     /// The period measured from the free end's zero crossings, and its relative error.
     pub measured_period: Option<f64>,
     pub period_error: Option<f64>,
@@ -40,14 +46,15 @@ pub struct BarRecord {
     pub points: usize,
 }
 
-case_record!(BarRecord);
+case_record!(DynamicRecord);
 
-impl BarRecord {
-    pub fn measure(&self, m: BarMeasure) -> Option<f64> {
+impl DynamicRecord {
+    pub fn measure(&self, m: DynamicMeasure) -> Option<f64> {
         match m {
-            BarMeasure::Displacement => self.displacement_error,
-            BarMeasure::Period => self.period_error,
-            BarMeasure::Energy => self.energy_drift,
+            DynamicMeasure::Displacement => self.displacement_error,
+            DynamicMeasure::Stress => self.stress_error,
+            DynamicMeasure::Period => self.period_error,
+            DynamicMeasure::Energy => self.energy_drift,
         }
     }
     pub fn series(&self) -> Series {
@@ -92,7 +99,7 @@ pub struct ExpectedBand {
 pub struct RateRecord {
     pub sweep: String,
     pub series: Series,
-    pub measure: BarMeasure,
+    pub measure: DynamicMeasure,
     pub refinement: Refinement,
     pub slope: Option<f64>,
     /// Elements (space) or steps per period (time) of the fitted levels.
@@ -101,16 +108,16 @@ pub struct RateRecord {
 }
 
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct BarMeasures {
+pub struct DynamicMeasures {
     pub rates: Vec<RateRecord>,
-    /// The analytical period 4L/c.
+    /// The period of the motion: the bar's 4L/c, the manufactured forcing's 2/c.
     pub exact_period: f64,
 }
 
-/// `results.json` of a vibrating-bar study.
-pub type BarResults = Envelope<BarStudy, BarRecord, BarMeasures>;
+/// `results.json` of a dynamics study.
+pub type DynamicResults = Envelope<DynamicStudy, DynamicRecord, DynamicMeasures>;
 
-impl BarResults {
+impl DynamicResults {
     /// The series of a sweep in plan order.
     pub fn sweep_series(&self, sweep: &str) -> Vec<Series> {
         let mut out: Vec<Series> = vec![];
@@ -123,8 +130,8 @@ impl BarResults {
     }
 
     /// One series' cases, coarse to fine in the sweep's refined variable.
-    pub fn series_cases(&self, sweep: &str, s: &Series) -> Vec<&BarRecord> {
-        let mut v: Vec<&BarRecord> = self
+    pub fn series_cases(&self, sweep: &str, s: &Series) -> Vec<&DynamicRecord> {
+        let mut v: Vec<&DynamicRecord> = self
             .sweep(sweep)
             .into_iter()
             .filter(|c| c.series() == *s)

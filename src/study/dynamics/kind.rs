@@ -1,11 +1,16 @@
-//! The vibrating bar as a study kind: one case is one bar solved by one method with one mass
-//! matrix, grid and time step ([`crate::problems::bar::solve`]); its record carries the
-//! displacement error, the period and the energy drift, and the free end's displacement
-//! history of the cases a history figure draws goes to `histories.json`.
+//! The dynamics study kind's solving and measuring: one case is one dynamic problem (the
+//! vibrating bar, [`crate::problems::bar::solve`], or a dynamic manufactured field,
+//! [`crate::problems::manufactured_dynamic::solve`]) solved by one method with one mass
+//! matrix, grid and time step; its record carries the errors at the end (and the bar's period
+//! and energy drift), and the bar's free-end displacement history of the cases a history
+//! figure draws goes to `histories.json`.
 
-use super::records::{BarMeasures, BarRecord, BarResults, ExpectedBand, RateRecord, Series};
-use super::{BarCase, BarMeasure, BarStudy, FigureKind, Refinement};
-use crate::problems::bar;
+use super::records::{DynamicMeasures, DynamicRecord, DynamicResults, ExpectedBand, RateRecord, Series};
+use super::CaseSpec;
+use super::{DynamicCase, DynamicMeasure, DynamicStudy, FigureKind, Refinement};
+use crate::load_stepping::StepReport;
+use crate::problems::bar::{self, BarSpec};
+use crate::problems::manufactured_dynamic::{self, DynamicManufacturedSpec};
 use crate::study::checks::{check_at_most, check_rate, CheckRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{write_case_data, SolveRecord, SweepIndex};
@@ -16,41 +21,58 @@ use std::path::Path;
 /// (t, u of the free end) after every step.
 pub type History = Vec<[f64; 2]>;
 
-fn solve_case(case: &BarCase) -> (BarRecord, History) {
-    let (mut solved, o) = match bar::solve(&case.spec, case.method) {
-        Err(e) => (SolveRecord::rejected(e), None),
-        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
-    };
+fn solve_case(case: &DynamicCase) -> (DynamicRecord, History) {
+    match &case.spec {
+        CaseSpec::Bar(spec) => solve_bar(case, spec),
+        CaseSpec::Manufactured(spec) => (solve_manufactured(case, spec), vec![]),
+    }
+}
+
+/// The step counts of a solve's record before its histories are cut to the last step's:
+/// (time steps, most Newton iterations of a step, steps accepted at their floor, steps cut back).
+fn step_counts(solved: &mut SolveRecord, steps: Option<&[StepReport]>) -> (usize, usize, usize, usize) {
     let time_steps = solved.steps.len();
-    let max_newton_iterations = o
-        .as_ref()
-        .and_then(|o| o.steps.iter().map(|s| s.newton.iterations()).max())
+    let max_newton_iterations = steps
+        .and_then(|s| s.iter().map(|s| s.newton.iterations()).max())
         .unwrap_or(0);
     let steps_at_floor = solved
         .steps
         .iter()
         .filter(|s| s.accepted_at_floor.is_some())
         .count();
-    let steps_cut_back = o
-        .as_ref()
-        .map_or(0, |o| o.steps.iter().filter(|s| s.cutbacks() > 0).count());
+    let steps_cut_back = steps.map_or(0, |s| s.iter().filter(|s| s.cutbacks() > 0).count());
     solved.steps.drain(..time_steps.saturating_sub(1));
+    (time_steps, max_newton_iterations, steps_at_floor, steps_cut_back)
+}
+
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+fn solve_bar(case: &DynamicCase, spec: &BarSpec) -> (DynamicRecord, History) {
+    let (mut solved, o) = match bar::solve(spec, case.method) {
+        Err(e) => (SolveRecord::rejected(e), None),
+        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
+    };
+    let (time_steps, max_newton_iterations, steps_at_floor, steps_cut_back) =
+        step_counts(&mut solved, o.as_ref().map(|o| o.steps.as_slice()));
     let conv = o.as_ref().filter(|o| o.failure.is_none());
-    let (exact, end) = (case.spec.period(), case.spec.duration());
-    let finite = |x: f64| x.is_finite().then_some(x);
-    let rec = BarRecord {
+    let (exact, end) = (spec.period(), spec.duration());
+    let rec = DynamicRecord {
         id: case.id.clone(),
         method: case.method,
-        mass: case.spec.mass,
-        elements: case.spec.elements,
-        points_per_cell: case.spec.points_per_cell,
-        steps_per_period: case.spec.steps_per_period,
+        field: None,
+        mass: spec.mass,
+        elements: spec.elements,
+        points_per_cell: spec.points_per_cell,
+        steps_per_period: spec.steps_per_period,
         solve: solved,
         time_steps,
         max_newton_iterations,
         steps_at_floor,
         steps_cut_back,
-        displacement_error: conv.and_then(|o| finite(o.displacement_error(&case.spec, end))),
+        displacement_error: conv.and_then(|o| finite(o.displacement_error(spec, end))),
+        stress_error: None,
         measured_period: conv.and_then(|o| o.measured_period),
         period_error: conv
             .and_then(|o| o.measured_period)
@@ -62,34 +84,69 @@ fn solve_case(case: &BarCase) -> (BarRecord, History) {
     (rec, history)
 }
 
-impl StudyKind for BarStudy {
-    const PROBLEM: &'static str = "bar";
-    type Case = BarCase;
-    type Output = (BarRecord, History);
-    type Record = BarRecord;
-    type Measures = BarMeasures;
+fn solve_manufactured(case: &DynamicCase, spec: &DynamicManufacturedSpec) -> DynamicRecord {
+    let (mut solved, o) = match manufactured_dynamic::solve(spec, case.method) {
+        Err(e) => (SolveRecord::rejected(e), None),
+        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
+    };
+    let (time_steps, max_newton_iterations, steps_at_floor, steps_cut_back) =
+        step_counts(&mut solved, o.as_ref().map(|o| o.steps.as_slice()));
+    let errors = o.as_ref().and_then(|o| o.errors);
+    DynamicRecord {
+        id: case.id.clone(),
+        method: case.method,
+        field: Some(spec.field),
+        mass: spec.mass,
+        elements: spec.cells,
+        points_per_cell: spec.points_per_cell,
+        steps_per_period: spec.steps_per_period,
+        solve: solved,
+        time_steps,
+        max_newton_iterations,
+        steps_at_floor,
+        steps_cut_back,
+        displacement_error: errors.and_then(|e| finite(e.displacement)),
+        stress_error: errors.and_then(|e| finite(e.stress)),
+        measured_period: None,
+        period_error: None,
+        energy_drift: None,
+        points: o.as_ref().map_or(0, |o| o.points.len()),
+    }
+}
+
+impl StudyKind for DynamicStudy {
+    const PROBLEM: &'static str = "dynamics";
+    type Case = DynamicCase;
+    type Output = (DynamicRecord, History);
+    type Record = DynamicRecord;
+    type Measures = DynamicMeasures;
 
     study_file_fields!();
-    fn cases(&self, tier: Tier) -> (Vec<BarCase>, SweepIndex) {
+    fn cases(&self, tier: Tier) -> (Vec<DynamicCase>, SweepIndex) {
         self.cases(tier)
     }
-    fn key(&self, c: &BarCase) -> CaseKey {
+    fn key(&self, c: &DynamicCase) -> CaseKey {
         CaseKey {
             has_vtk: false,
             ..CaseKey::of_spec(&c.id, c.method, &c.spec, 0)
         }
     }
-    fn cost(&self, c: &BarCase) -> f64 {
-        (c.spec.elements * c.spec.points_per_cell * c.spec.time_steps()) as f64
+    fn cost(&self, c: &DynamicCase) -> f64 {
+        c.spec.cost()
     }
-    fn solve(&self, c: &BarCase, _vtk: Option<&VtkTarget>) -> Result<Self::Output, StudyError> {
+    fn solve(&self, c: &DynamicCase, _vtk: Option<&VtkTarget>) -> Result<Self::Output, StudyError> {
         Ok(solve_case(c))
     }
-    fn record(o: &Self::Output) -> &BarRecord {
+    fn record(o: &Self::Output) -> &DynamicRecord {
         &o.0
     }
     fn measure(results: &mut Results<Self>) {
-        results.measures.exact_period = results.study.case_spec(Default::default(), 1, 1, 1).period();
+        let study = &results.study;
+        results.measures.exact_period = study
+            .sweeps
+            .iter()
+            .find_map(|s| study.case_spec(s, Default::default(), 1, 1, 1))
+            .map_or(f64::NAN, |c| c.period());
         results.measures.rates = rates(results);
         results.checks = checks(results);
     }
@@ -100,13 +157,13 @@ impl StudyKind for BarStudy {
     }
 }
 
-impl BarStudy {
+impl DynamicStudy {
     /// The finest case of every series of each sweep a history figure draws.
-    fn drawn_cases<'a>(&self, records: impl Iterator<Item = &'a BarRecord> + Clone) -> BTreeSet<String> {
+    fn drawn_cases<'a>(&self, records: impl Iterator<Item = &'a DynamicRecord> + Clone) -> BTreeSet<String> {
         let mut out = BTreeSet::new();
         for f in self.figures.iter().filter(|f| f.kind == FigureKind::History) {
             let Some(sw) = self.sweep(&f.sweep) else { continue };
-            let in_sweep = |r: &&BarRecord| {
+            let in_sweep = |r: &&DynamicRecord| {
                 sw.methods.contains(&r.method)
                     && sw.mass.contains(&r.mass)
                     && sw.points_per_cell.contains(&(r.points_per_cell as i64))
@@ -125,13 +182,13 @@ impl BarStudy {
 }
 
 /// The finest of `cases`: most elements, then most time steps.
-fn finest<'a>(cases: impl Iterator<Item = &'a BarRecord>) -> Option<&'a BarRecord> {
+fn finest<'a>(cases: impl Iterator<Item = &'a DynamicRecord>) -> Option<&'a DynamicRecord> {
     cases.max_by_key(|c| (c.elements, c.steps_per_period))
 }
 
 /// The refined variable's step of a case: h = L / elements or Δt = T / steps per period (in
 /// units of L and T: only ratios enter a slope).
-fn level_size(r: &BarRecord, refinement: Refinement) -> (usize, f64) {
+fn level_size(r: &DynamicRecord, refinement: Refinement) -> (usize, f64) {
     let n = match refinement {
         Refinement::Space => r.elements,
         Refinement::Time => r.steps_per_period,
@@ -139,13 +196,18 @@ fn level_size(r: &BarRecord, refinement: Refinement) -> (usize, f64) {
     (n, 1.0 / n as f64)
 }
 
-fn rates(results: &BarResults) -> Vec<RateRecord> {
+fn rates(results: &DynamicResults) -> Vec<RateRecord> {
     let study = &results.study;
     let mut out = vec![];
     for sw in &study.sweeps {
         let refinement = sw.refinement();
         for s in results.sweep_series(&sw.id) {
-            for measure in [BarMeasure::Displacement, BarMeasure::Period] {
+            let measures = if study.bar.is_some() {
+                [DynamicMeasure::Displacement, DynamicMeasure::Period]
+            } else {
+                [DynamicMeasure::Displacement, DynamicMeasure::Stress]
+            };
+            for measure in measures {
                 let pts: Vec<(usize, f64, f64)> = results
                     .series_cases(&sw.id, &s)
                     .into_iter()
@@ -187,7 +249,7 @@ fn rates(results: &BarResults) -> Vec<RateRecord> {
     out
 }
 
-fn checks(results: &BarResults) -> Vec<CheckRecord> {
+fn checks(results: &DynamicResults) -> Vec<CheckRecord> {
     let tier = results.provenance.tier;
     let in_tier =
         |t: Option<Tier>, sweep: &str| t.is_none_or(|t| t == tier) && results.sweep_cases.contains_key(sweep);

@@ -1,13 +1,14 @@
-//! Rendering of the vibrating-bar study: the report (every case's error, period and energy,
-//! fitted rates with their bands, checks), the log-log convergence figures and the free end's
-//! history against the analytical one, from `results.json` and `histories.json` only.
+//! Rendering of a dynamics study: the report (every case's errors, and the bar's period and
+//! energy, fitted rates with their bands, checks), the log-log convergence figures and the
+//! bar's free-end history against the analytical one, from `results.json` and
+//! `histories.json` only.
 
 use super::{checks_markdown, failures_markdown, IndexEntry};
 use crate::plot::{convergence_svg_along, profile_svg, ConvergenceSeries, ProfileSeries};
-use crate::study::bar::kind::History;
-use crate::study::bar::records::BarResults;
-use crate::study::bar::{BarMeasure, FigureKind, FigureSpec, Refinement};
 use crate::study::checks::check_counts;
+use crate::study::dynamics::kind::History;
+use crate::study::dynamics::records::DynamicResults;
+use crate::study::dynamics::{DynamicMeasure, FigureKind, FigureSpec, Refinement};
 use crate::study::results::{read_json, read_results};
 use crate::study::StudyError;
 use std::collections::BTreeMap;
@@ -22,9 +23,8 @@ fn r2(x: Option<f64>) -> String {
     x.map_or("—".into(), |v| format!("{v:.2}"))
 }
 
-pub fn report_markdown(results: &BarResults, not_drawn: &[super::NotDrawn]) -> String {
+pub fn report_markdown(results: &DynamicResults, not_drawn: &[super::NotDrawn]) -> String {
     let study = &results.study;
-    let b = &study.bar;
     let (pass, fail, none) = check_counts(&results.checks);
     let mut s = format!(
         "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated.\n\n",
@@ -32,45 +32,83 @@ pub fn report_markdown(results: &BarResults, not_drawn: &[super::NotDrawn]) -> S
         study.summary,
         results.provenance.line()
     );
-    let _ = writeln!(
-        s,
-        "A fixed–free bar, L = {}, E = {}, ρ = {}, ν = 0 (Hencky), set moving in its first mode v(X, 0) = v₀ sin(πX/2L) with v₀ = {} (strain amplitude v₀/c = {:.1e}); Newmark β = {}, γ = {} over {} periods of T = 4L/c = {}. Errors: displacement ‖u_h − u‖/‖u‖ over the points at the end against u = (v₀/ω) sin(πX/2L) sin(ωt); period from the free end's downward zero crossings; energy max |E(t) − E(0)|/E(0), E = kinetic + strain. Rates are slopes of log(measure) against log(h) (space sweeps) or log(Δt) (time sweeps).\n",
-        b.length,
-        b.young_modulus,
-        b.density,
-        b.velocity,
-        b.velocity / (b.young_modulus / b.density).sqrt(),
-        b.beta,
-        b.gamma,
-        b.periods,
-        results.measures.exact_period
-    );
+    if let Some(b) = &study.bar {
+        let _ = writeln!(
+            s,
+            "A fixed–free bar, L = {}, E = {}, ρ = {}, ν = 0 (Hencky), set moving in its first mode v(X, 0) = v₀ sin(πX/2L) with v₀ = {} (strain amplitude v₀/c = {:.1e}); Newmark β = {}, γ = {} over {} periods of T = 4L/c = {}. Errors: displacement ‖u_h − u‖/‖u‖ over the points at the end against u = (v₀/ω) sin(πX/2L) sin(ωt); period from the free end's downward zero crossings; energy max |E(t) − E(0)|/E(0), E = kinetic + strain. Rates are slopes of log(measure) against log(h) (space sweeps) or log(Δt) (time sweeps).\n",
+            b.length,
+            b.young_modulus,
+            b.density,
+            b.velocity,
+            b.velocity / (b.young_modulus / b.density).sqrt(),
+            b.beta,
+            b.gamma,
+            b.periods,
+            results.measures.exact_period
+        );
+    }
+    if let Some(m) = &study.manufactured {
+        let _ = writeln!(
+            s,
+            "The unit square (plane strain, Hencky, E = {}, ν = {}, ρ₀ = {}) moved by a manufactured field with amplitude a(t) = A sin ωt, ω = πc, c = √(E/ρ₀) (Wallstedt & Guilkey 2008): axis-aligned x = X + a(t)(sin πX, sin πY) (A = {}), vortex x = c + R(a(t)(1 − 4r²)³)(X − c) (θ₀ = {}); rollers on every edge, the body force b₀ = ρ₀ẍ − Div P at the points, the exact velocity and acceleration at t = 0. Newmark β = {}, γ = {} over {} periods of T = 2/c = {}. Errors at the end against the field: displacement ‖x_p − x(X_p)‖/‖u(X_p)‖ and stress Σ‖σ_p − σ(X_p)‖ v_p0/(σ_max |Ω₀|), the form of eq (46). Rates are slopes of log(error) against log(h) (space sweeps) or log(Δt) (time sweeps).\n",
+            m.young_modulus,
+            m.poisson_ratio,
+            m.density,
+            m.amplitude.axis_aligned,
+            m.amplitude.vortex,
+            m.beta,
+            m.gamma,
+            m.periods,
+            results.measures.exact_period
+        );
+    }
     for sw in &study.sweeps {
         if !results.sweep_cases.contains_key(&sw.id) {
             continue;
         }
-        let _ = writeln!(
-            s,
-            "## {}\n\n{}\n\n| case | elements | steps per period | displacement | period | period error | energy | Newton iterations (most per step) | steps at round-off floor | steps cut back |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
-            sw.id, sw.title
-        );
+        if study.bar.is_some() {
+            let _ = writeln!(
+                s,
+                "## {}\n\n{}\n\n| case | elements | steps per period | displacement | period | period error | energy | Newton iterations (most per step) | steps at round-off floor | steps cut back |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+                sw.id, sw.title
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "## {}\n\n{}\n\n| case | cells per side | steps per period | displacement | stress | Newton iterations (most per step) | steps at round-off floor | steps cut back |\n|---|---:|---:|---:|---:|---:|---:|---:|",
+                sw.id, sw.title
+            );
+        }
         for ser in results.sweep_series(&sw.id) {
             for c in results.series_cases(&sw.id, &ser) {
-                let _ = writeln!(
-                    s,
-                    "| {} | {} | {} | {} | {} | {} | {} | {} ({}) | {} | {} |",
-                    c.id,
-                    c.elements,
-                    c.steps_per_period,
-                    e3(c.displacement_error),
-                    c.measured_period.map_or("—".into(), |t| format!("{t:.6}")),
-                    e3(c.period_error),
-                    e3(c.energy_drift),
-                    c.solve.newton_iterations,
-                    c.max_newton_iterations,
-                    c.steps_at_floor,
-                    c.steps_cut_back
-                );
+                let newton = format!("{} ({})", c.solve.newton_iterations, c.max_newton_iterations);
+                if study.bar.is_some() {
+                    let _ = writeln!(
+                        s,
+                        "| {} | {} | {} | {} | {} | {} | {} | {newton} | {} | {} |",
+                        c.id,
+                        c.elements,
+                        c.steps_per_period,
+                        e3(c.displacement_error),
+                        c.measured_period.map_or("—".into(), |t| format!("{t:.6}")),
+                        e3(c.period_error),
+                        e3(c.energy_drift),
+                        c.steps_at_floor,
+                        c.steps_cut_back
+                    );
+                } else {
+                    let _ = writeln!(
+                        s,
+                        "| {} | {} | {} | {} | {} | {newton} | {} | {} |",
+                        c.id,
+                        c.elements,
+                        c.steps_per_period,
+                        e3(c.displacement_error),
+                        e3(c.stress_error),
+                        c.steps_at_floor,
+                        c.steps_cut_back
+                    );
+                }
             }
         }
         s.push('\n');
@@ -116,7 +154,7 @@ pub fn report_markdown(results: &BarResults, not_drawn: &[super::NotDrawn]) -> S
 }
 
 fn render_figure(
-    results: &BarResults,
+    results: &DynamicResults,
     histories: &BTreeMap<String, History>,
     dir: &Path,
     f: &FigureSpec,
@@ -127,7 +165,7 @@ fn render_figure(
     };
     match f.kind {
         FigureKind::Convergence => {
-            let m = f.measure.unwrap_or(BarMeasure::Displacement);
+            let m = f.measure.unwrap_or(DynamicMeasure::Displacement);
             let refinement = sw.refinement();
             let series: Vec<ConvergenceSeries> = results
                 .sweep_series(&f.sweep)
@@ -164,12 +202,14 @@ fn render_figure(
                 Refinement::Space => "elements (h = L/n)",
                 Refinement::Time => "time steps per period (Δt = T/n)",
             };
-            convergence_svg_along(&f.title, x, m.label(), &series, m != BarMeasure::Energy)
+            convergence_svg_along(&f.title, x, m.label(), &series, m != DynamicMeasure::Energy)
                 .map(Some)
                 .map_err(err)
         }
         FigureKind::History => {
-            let b = &results.study.bar;
+            let Some(b) = &results.study.bar else {
+                return Ok(None);
+            };
             let t_period = results.measures.exact_period;
             let amplitude = b.velocity / (2.0 * std::f64::consts::PI / t_period);
             let series: Vec<ProfileSeries> = results
@@ -211,7 +251,7 @@ fn render_figure(
 
 /// Render the report and figures from `dir`'s `results.json` and `histories.json`.
 pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
-    let results: BarResults = read_results(dir)?;
+    let results: DynamicResults = read_results(dir)?;
     let histories: BTreeMap<String, History> = read_json(&dir.join("histories.json"))?;
     let mut files = super::Files::new(dir);
     for f in super::figures_in_tier(
@@ -231,7 +271,7 @@ pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
 }
 
 pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
-    let r: BarResults = read_results(dir)?;
+    let r: DynamicResults = read_results(dir)?;
     Ok(super::plane_index_entry(
         (&r.study.name, &r.study.summary, r.provenance.tier),
         ("the free-end histories", "histories.json"),

@@ -1,0 +1,102 @@
+//! The dynamic manufactured study (`studies/manufactured-dynamic.toml`), quick tier: every
+//! check passes, the outputs re-render byte for byte, and a study file that gives both problem
+//! sections, or a manufactured sweep without its field, is refused with the key named.
+
+use igimp::render::dynamics::render;
+use igimp::study::dynamics::DynamicStudy;
+use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
+use igimp::study::Tier;
+use std::path::Path;
+use std::sync::OnceLock;
+
+fn path() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/manufactured-dynamic.toml")
+}
+
+fn study() -> DynamicStudy {
+    DynamicStudy::load(&path()).expect("studies/manufactured-dynamic.toml parses")
+}
+
+fn quick() -> &'static Run<DynamicStudy> {
+    static RUN: OnceLock<Run<DynamicStudy>> = OnceLock::new();
+    RUN.get_or_init(|| {
+        run_in_memory(&study(), "manufactured-dynamic.toml", Tier::Quick).expect("an in-memory run")
+    })
+}
+
+/// Every quick-tier check is evaluated and passes, and no time step was cut back (a cut step
+/// would change Δt inside a convergence series).
+#[test]
+fn every_dynamic_manufactured_check_passes() {
+    let r = &quick().results;
+    assert!(
+        r.checks.len() >= 4,
+        "{:?}",
+        r.checks.iter().map(|c| &c.id).collect::<Vec<_>>()
+    );
+    for c in &r.checks {
+        assert_eq!(
+            c.pass,
+            Some(true),
+            "{}: {} (measured {:?})",
+            c.id,
+            c.description,
+            c.measured
+        );
+    }
+    for c in &r.cases {
+        assert_eq!(c.steps_cut_back, 0, "{}", c.id);
+        assert!(
+            c.stress_error.is_some() && c.displacement_error.is_some(),
+            "{}",
+            c.id
+        );
+    }
+}
+
+/// Rendering twice from the written results gives the same bytes.
+#[test]
+fn dynamic_manufactured_outputs_rerender_byte_identically() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = write_outputs(tmp.path(), quick()).unwrap();
+    let first = render(&dir).unwrap();
+    assert!(first.not_drawn.is_empty(), "{:?}", first.not_drawn);
+    let read = |f: &str| std::fs::read(dir.join(f)).unwrap();
+    let files = [
+        "report.md",
+        "axis-space-displacement.svg",
+        "axis-time-displacement.svg",
+    ];
+    let before: Vec<Vec<u8>> = files.iter().map(|f| read(f)).collect();
+    render(&dir).unwrap();
+    for (f, b) in files.iter().zip(before) {
+        assert_eq!(read(f), b, "{f} changed on re-render");
+    }
+}
+
+/// A file with both `[bar]` and `[manufactured]`, and a manufactured sweep without `field`,
+/// are refused naming the key.
+#[test]
+fn a_dynamics_file_defines_one_problem_and_every_field() {
+    let text = std::fs::read_to_string(path()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let refused = |text: String, key: &str| {
+        let p = dir.path().join("m.toml");
+        std::fs::write(&p, text).unwrap();
+        let e = match DynamicStudy::load(&p) {
+            Ok(_) => panic!("{key}: accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(e.contains(key), "{e}");
+    };
+    let bar =
+        "[bar]\nlength = 1.0\nyoung_modulus = 100.0\ndensity = 1.0\nvelocity = 1.0e-3\nperiods = 3.0\n\n";
+    refused(
+        text.replacen("[manufactured]", &format!("{bar}[manufactured]"), 1),
+        "manufactured",
+    );
+    refused(
+        text.replacen("field = \"axis-aligned\"\n", "", 1),
+        "sweeps[0].field",
+    );
+}
