@@ -147,6 +147,36 @@ impl PointValue3 {
     }
 }
 
+/// The material points of a 3D solver as the error measures and point files take them.
+pub(crate) fn point_values_3d(p: &MaterialPoints<3>) -> Vec<PointValue3> {
+    let arr = |v: &V3| [v[0], v[1], v[2]];
+    (0..p.len())
+        .map(|i| PointValue3 {
+            x0: arr(&p.position0[i]),
+            x: arr(&p.position[i]),
+            volume0: p.volume0[i],
+            sigma: rows(&p.state[i].cauchy()),
+            half: arr(&p.half_length[i]),
+        })
+        .collect()
+}
+
+/// The Gauss points of a solid FEM solver as the error measures and point files take them.
+pub(crate) fn gauss_values_3d(fem: &SolidFem) -> Vec<PointValue3> {
+    (0..fem.gauss.len())
+        .map(|g| {
+            let (x, x0) = (fem.gauss_point_position(g), fem.gauss.position0[g]);
+            PointValue3 {
+                x0: [x0[0], x0[1], x0[2]],
+                x: [x[0], x[1], x[2]],
+                volume0: fem.gauss.volume0[g],
+                sigma: rows(&fem.cauchy_stress(g)),
+                half: [0.0; 3],
+            }
+        })
+        .collect()
+}
+
 fn rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
     std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
 }
@@ -237,17 +267,7 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
                 Ok(s) => (s, None),
                 Err((s, e)) => (s, Some(e)),
             };
-            let p = &solver.points;
-            let arr = |v: &V3| [v[0], v[1], v[2]];
-            let values: Vec<PointValue3> = (0..p.len())
-                .map(|i| PointValue3 {
-                    x0: arr(&p.position0[i]),
-                    x: arr(&p.position[i]),
-                    volume0: p.volume0[i],
-                    sigma: rows(&p.state[i].cauchy()),
-                    half: arr(&p.half_length[i]),
-                })
-                .collect();
+            let values = point_values_3d(&solver.points);
             (steps, failure, values)
         }
         Method::FEM_HEX8 | Method::FEM_HEX20 => {
@@ -287,18 +307,7 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
                 Ok(s) => (s, None),
                 Err((s, e)) => (s, Some(e)),
             };
-            let values: Vec<PointValue3> = (0..fem.gauss.len())
-                .map(|g| {
-                    let (x, x0) = (fem.gauss_point_position(g), fem.gauss.position0[g]);
-                    PointValue3 {
-                        x0: [x0[0], x0[1], x0[2]],
-                        x: [x[0], x[1], x[2]],
-                        volume0: fem.gauss.volume0[g],
-                        sigma: rows(&fem.cauchy_stress(g)),
-                        half: [0.0; 3],
-                    }
-                })
-                .collect();
+            let values = gauss_values_3d(&fem);
             (steps, failure, values)
         }
         _ => return Err(method.unsupported("3D manufactured problem", &METHODS_3D)),

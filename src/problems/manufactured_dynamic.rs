@@ -1,7 +1,9 @@
-//! Dynamic manufactured solutions in plane strain (Wallstedt & Guilkey, *J. Comput. Phys.* 227
-//! (2008) 9628, §4: a prescribed motion, its body force b₀ = ρ₀ ẍ − Div P, errors against the
-//! motion). The material fills the unit square, which is also the background grid or the
-//! FEM mesh; rollers on every edge, as in the static fields ([`super::manufactured`]).
+//! Dynamic manufactured solutions (Wallstedt & Guilkey, *J. Comput. Phys.* 227 (2008) 9628,
+//! §4: a prescribed motion, its body force b₀ = ρ₀ ẍ − Div P, errors against the motion) in
+//! plane strain on the unit square and on the unit cube (`dimension = 3`: the fields of
+//! [`super::manufactured3d`], the axis-aligned one on three axes, the vortex about z). The
+//! material fills the square (cube), which is also the background grid or the FEM mesh;
+//! rollers on every face, as in the static fields ([`super::manufactured`]).
 //!
 //! Each static field's amplitude is made to oscillate: a(t) = A sin ωt with ω = πc,
 //! c = √(E/ρ₀), as Wallstedt & Guilkey's axis-aligned field u = A sin(2πX) sin(cπt):
@@ -22,14 +24,19 @@
 use super::manufactured::{
     errors, fem_point_values, mpm_point_values, rollers, Exact, Field, ManufacturedSolution,
 };
+use super::manufactured3d::{errors_3d, point_values_3d, Exact3, Solution3, METHODS_3D};
 use crate::basis::DomainUpdate;
 use crate::constitutive::{lame, LinearElastic};
 use crate::dynamics::{BodyForce, LoadHistory, MassMatrix, Newmark};
+use crate::error::SolveError;
 use crate::error::{require_count, require_positive, InputError};
-use crate::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
+use crate::fem::{
+    ContinuumFem, ElementFamily, ElementMesh, FemLoads, HexElement, HexMesh, PlaneFemSettings, PlaneMesh,
+    QuadElement,
+};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
-use crate::load_stepping::LoadStepping;
+use crate::load_stepping::{LoadStepping, StepReport};
 use crate::method::Method;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
 use crate::newton::NewtonSettings;
@@ -66,6 +73,17 @@ pub struct DynamicManufacturedSpec {
     pub mass: MassMatrix,
     pub newton: NewtonSettings,
     pub domain_update: DomainUpdate,
+    /// 2 (the unit square, plane strain) or 3 (the unit cube). Not serialised at 2.
+    #[serde(default = "plane", skip_serializing_if = "is_plane")]
+    pub dimension: usize,
+}
+
+fn plane() -> usize {
+    2
+}
+
+fn is_plane(d: &usize) -> bool {
+    *d == 2
 }
 
 impl Default for DynamicManufacturedSpec {
@@ -89,6 +107,7 @@ impl Default for DynamicManufacturedSpec {
             mass: MassMatrix::Consistent,
             newton: NewtonSettings::default(),
             domain_update: DomainUpdate::Stretch,
+            dimension: 2,
         }
     }
 }
@@ -98,8 +117,14 @@ impl DynamicManufacturedSpec {
         require_positive("young_modulus", self.young_modulus)?;
         require_positive("density", self.density)?;
         require_count("cells", self.cells, 1)?;
-        if self.cells > 1024 {
-            return Err(InputError::new("cells", self.cells, "must be <= 1024"));
+        // 1024² cells are 4e6 points at 2 × 2 per cell; 128³ are 1.7e7 at 2 × 2 × 2.
+        let max_cells = if self.dimension == 3 { 128 } else { 1024 };
+        if self.cells > max_cells {
+            return Err(InputError::new(
+                "cells",
+                self.cells,
+                format!("must be <= {max_cells} in {}D", self.dimension),
+            ));
         }
         require_count("points_per_cell", self.points_per_cell, 1)?;
         if self.points_per_cell > 8 {
@@ -163,7 +188,16 @@ impl DynamicManufacturedSpec {
             load_steps: self.time_steps(),
             newton: self.newton,
             domain_update: self.domain_update,
-            dimension: 2,
+            dimension: self.dimension,
+        }
+    }
+
+    /// The methods of this spec's dimension.
+    pub fn methods(&self) -> &'static [Method] {
+        if self.dimension == 3 {
+            &METHODS_3D
+        } else {
+            &METHODS
         }
     }
 
@@ -240,46 +274,95 @@ impl ExactMotion {
         }
     }
 
-    /// ẋ(X, t).
-    pub fn velocity(&self, x: [f64; 2], t: f64) -> [f64; 2] {
-        let (a, da, _) = self.amplitude_at(t);
-        let (d1, _) = self.amplitude_derivatives(a, x);
-        [d1[0] * da, d1[1] * da]
+    /// ∂x/∂a along z at Z (3D fields; ∂²x/∂a² is zero there): the axis-aligned field moves z
+    /// as x and y, the vortex about z not at all.
+    fn amplitude_derivative_z(&self, z: f64) -> f64 {
+        match self.field {
+            Field::AxisAligned => (PI * z).sin(),
+            Field::Vortex => 0.0,
+        }
     }
 
-    /// ẍ(X, t).
-    pub fn acceleration(&self, x: [f64; 2], t: f64) -> [f64; 2] {
+    /// (ẋ, ẍ) at X, t in D = 2 or 3 dimensions.
+    pub fn motion_rates<const D: usize>(
+        &self,
+        x: &SVector<f64, D>,
+        t: f64,
+    ) -> (SVector<f64, D>, SVector<f64, D>) {
         let (a, da, dda) = self.amplitude_at(t);
-        let (d1, d2) = self.amplitude_derivatives(a, x);
-        [d2[0] * da * da + d1[0] * dda, d2[1] * da * da + d1[1] * dda]
+        let (d1, d2) = self.amplitude_derivatives(a, [x[0], x[1]]);
+        let mut v = SVector::<f64, D>::zeros();
+        let mut acc = SVector::<f64, D>::zeros();
+        for i in 0..2 {
+            v[i] = d1[i] * da;
+            acc[i] = d2[i] * da * da + d1[i] * dda;
+        }
+        if D == 3 {
+            let dz = self.amplitude_derivative_z(x[2]);
+            v[2] = dz * da;
+            acc[2] = dz * dda;
+        }
+        (v, acc)
     }
 
-    /// b₀(X, t) = ρ₀ ẍ − Div P per unit reference volume.
+    /// ẋ(X, t) (plane).
+    pub fn velocity(&self, x: [f64; 2], t: f64) -> [f64; 2] {
+        let v = self.motion_rates(&SVector::<f64, 2>::new(x[0], x[1]), t).0;
+        [v[0], v[1]]
+    }
+
+    /// ẍ(X, t) (plane).
+    pub fn acceleration(&self, x: [f64; 2], t: f64) -> [f64; 2] {
+        let a = self.motion_rates(&SVector::<f64, 2>::new(x[0], x[1]), t).1;
+        [a[0], a[1]]
+    }
+
+    /// The 3D field at time t (position, stresses, −Div P at amplitude a(t)).
+    pub fn at_3d(&self, t: f64) -> Exact3 {
+        Exact3 {
+            field: self.field,
+            amplitude: self.amplitude_at(t).0,
+            lambda: self.lambda,
+            mu: self.mu,
+        }
+    }
+
+    /// b₀(X, t) = ρ₀ ẍ − Div P per unit reference volume, in D = 2 or 3 dimensions.
+    pub fn body_force_at<const D: usize>(&self, x: &SVector<f64, D>, t: f64) -> SVector<f64, D> {
+        let acc = self.motion_rates(x, t).1;
+        let minus_div: SVector<f64, D> = if D == 3 {
+            let b = self.at_3d(t).body_force([x[0], x[1], x[2]]);
+            SVector::<f64, D>::from_fn(|i, _| b[i])
+        } else {
+            let d = self.at(t).div_first_piola([x[0], x[1]]);
+            SVector::<f64, D>::from_fn(|i, _| -d[i])
+        };
+        acc * self.density + minus_div
+    }
+
+    /// b₀(X, t) (plane).
     pub fn body_force(&self, x: [f64; 2], t: f64) -> [f64; 2] {
-        let acc = self.acceleration(x, t);
-        let div = self.at(t).div_first_piola(x);
-        [self.density * acc[0] - div[0], self.density * acc[1] - div[1]]
+        let b = self.body_force_at(&SVector::<f64, 2>::new(x[0], x[1]), t);
+        [b[0], b[1]]
     }
 
     /// The body force as the solvers take it.
-    pub fn body_force_field(&self) -> BodyForce<2> {
+    pub fn body_force_field<const D: usize>(&self) -> BodyForce<D> {
         let m = *self;
-        BodyForce::new(move |x, t| {
-            let b = m.body_force([x[0], x[1]], t);
-            SVector::<f64, 2>::new(b[0], b[1])
-        })
+        BodyForce::new(move |x, t| m.body_force_at(x, t))
     }
 }
 
-fn vector(v: [f64; 2]) -> SVector<f64, 2> {
-    SVector::<f64, 2>::new(v[0], v[1])
-}
-
-/// The material point solver of `spec` (any family): points of density ρ₀ filling the unit
-/// square grid with the exact initial velocity and acceleration, rollers on every edge, the
-/// body force b₀(X, t), Newmark steps over the duration.
-pub fn mpm_solver(spec: &DynamicManufacturedSpec, method: Method) -> Result<MpmSolver<2>, InputError> {
+/// The material point solver of `spec` (any family) in D = `spec.dimension` dimensions:
+/// points of density ρ₀ filling the unit square (cube) grid with the exact initial velocity and
+/// acceleration, rollers on every face, the body force b₀(X, t), Newmark steps over the
+/// duration.
+pub fn mpm_solver<const D: usize>(
+    spec: &DynamicManufacturedSpec,
+    method: Method,
+) -> Result<MpmSolver<D>, InputError> {
     spec.validate()?;
+    check_dimension::<D>(spec)?;
     let basis = method.basis().ok_or_else(|| {
         method.unsupported(
             "dynamic manufactured material point solver",
@@ -288,15 +371,15 @@ pub fn mpm_solver(spec: &DynamicManufacturedSpec, method: Method) -> Result<MpmS
     })?;
     let exact = ExactMotion::of(spec);
     let h = spec.element_size();
-    let grid = Grid::try_new([0.0, 0.0], [h, h], [spec.cells, spec.cells])?;
+    let grid = Grid::<D>::try_new([0.0; D], [h; D], [spec.cells; D])?;
     let ppc = spec.points_per_cell;
-    let mut points = MaterialPoints::fill_box(&grid, [0.0, 0.0], [1.0, 1.0], [ppc, ppc], spec.density)?;
+    let mut points = MaterialPoints::fill_box(&grid, [0.0; D], [1.0; D], [ppc; D], spec.density)?;
     for p in 0..points.len() {
-        let x0 = [points.position0[p][0], points.position0[p][1]];
-        points.velocity[p] = vector(exact.velocity(x0, 0.0));
-        points.acceleration[p] = vector(exact.acceleration(x0, 0.0));
+        let (v, a) = exact.motion_rates(&points.position0[p], 0.0);
+        points.velocity[p] = v;
+        points.acceleration[p] = a;
     }
-    let fixed = rollers(2, |axis, value| grid.nodes_on_plane(axis, value));
+    let fixed = rollers(D, |axis, value| grid.nodes_on_plane(axis, value));
     let settings = MpmSettings {
         basis,
         domain_update: spec.domain_update,
@@ -319,11 +402,55 @@ pub fn mpm_solver(spec: &DynamicManufacturedSpec, method: Method) -> Result<MpmS
     Ok(solver)
 }
 
-/// The Q4 (`fem-q4`) or Q8 (`fem-q8`) solver of `spec`: the unit square meshed by its cells,
-/// the exact nodal velocities and accelerations at t = 0, rollers on every edge, the body
-/// force at the Gauss points (2 × 2 for Q4, 3 × 3 for Q8).
-pub fn fem_solver(spec: &DynamicManufacturedSpec, method: Method) -> Result<PlaneFem, InputError> {
+fn check_dimension<const D: usize>(spec: &DynamicManufacturedSpec) -> Result<(), InputError> {
+    if spec.dimension != D {
+        return Err(InputError::new(
+            "dimension",
+            spec.dimension,
+            format!("must be {D} for this solver"),
+        ));
+    }
+    Ok(())
+}
+
+/// The element solver of `spec` on `mesh` (the unit square or cube meshed by its cells): the
+/// exact nodal velocities and accelerations at t = 0, rollers on every face, the body force at
+/// the Gauss points (the element's default rule: 2 per axis for the linear elements, 3 for the
+/// serendipity ones).
+fn fem_solver_on<const D: usize, E: ElementFamily<D>>(
+    spec: &DynamicManufacturedSpec,
+    mesh: ElementMesh<D, E>,
+    linear_solver: LinearSolver,
+) -> Result<ContinuumFem<D, E>, InputError> {
+    let exact = ExactMotion::of(spec);
+    let n = spec.cells;
+    let fixed = rollers(D, |axis, value| mesh.nodes_at(axis, value, 1e-9 / n as f64));
+    let (velocity, acceleration): (Vec<_>, Vec<_>) =
+        mesh.nodes.iter().map(|x| exact.motion_rates(x, 0.0)).unzip();
+    let settings = PlaneFemSettings {
+        gauss_points: None,
+        newton: spec.newton,
+        load_steps: spec.time_steps(),
+        linear_solver,
+    };
+    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    let loads = FemLoads {
+        gravity: SVector::zeros(),
+        nodal_forces: vec![],
+    };
+    let mut fem = ContinuumFem::try_new(mesh, spec.density, model, fixed, loads, settings)?;
+    fem.set_dynamics(spec.newmark(), &velocity, Some(&acceleration))?;
+    fem.set_body_force(exact.body_force_field());
+    Ok(fem)
+}
+
+/// The Q4 (`fem-q4`) or Q8 (`fem-q8`) solver of a plane `spec`.
+pub fn fem_solver(
+    spec: &DynamicManufacturedSpec,
+    method: Method,
+) -> Result<ContinuumFem<2, QuadElement>, InputError> {
     spec.validate()?;
+    check_dimension::<2>(spec)?;
     let element = match method {
         Method::FEM_Q4 => QuadElement::Q4,
         Method::FEM_Q8 => QuadElement::Q8,
@@ -334,7 +461,6 @@ pub fn fem_solver(spec: &DynamicManufacturedSpec, method: Method) -> Result<Plan
             ))
         }
     };
-    let exact = ExactMotion::of(spec);
     let n = spec.cells;
     let mesh = PlaneMesh::rectangle(
         SVector::zeros(),
@@ -342,35 +468,50 @@ pub fn fem_solver(spec: &DynamicManufacturedSpec, method: Method) -> Result<Plan
         (n, n),
         element,
     )?;
-    let fixed = rollers(2, |axis, value| mesh.nodes_at(axis, value, 1e-9 / n as f64));
-    let at_nodes = |f: &dyn Fn([f64; 2]) -> [f64; 2]| -> Vec<SVector<f64, 2>> {
-        mesh.nodes.iter().map(|x| vector(f([x[0], x[1]]))).collect()
-    };
-    let velocity = at_nodes(&|x| exact.velocity(x, 0.0));
-    let acceleration = at_nodes(&|x| exact.acceleration(x, 0.0));
-    let settings = PlaneFemSettings {
-        gauss_points: Some(if element == QuadElement::Q4 { 2 } else { 3 }),
-        newton: spec.newton,
-        load_steps: spec.time_steps(),
-        linear_solver: LinearSolver::Lu,
-    };
-    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
-    let loads = PlaneLoads {
-        gravity: SVector::zeros(),
-        nodal_forces: vec![],
-    };
-    let mut fem = PlaneFem::try_new(mesh, spec.density, model, fixed, loads, settings)?;
-    fem.set_dynamics(spec.newmark(), &velocity, Some(&acceleration))?;
-    fem.set_body_force(exact.body_force_field());
-    Ok(fem)
+    fem_solver_on(spec, mesh, LinearSolver::Lu)
 }
 
-/// Solve one dynamic manufactured analysis by `method` and measure its errors at the end.
+/// The Hex8 (`fem-hex8`) or Hex20 (`fem-hex20`) solver of a 3D `spec`.
+pub fn fem_solver_3d(
+    spec: &DynamicManufacturedSpec,
+    method: Method,
+) -> Result<ContinuumFem<3, HexElement>, InputError> {
+    spec.validate()?;
+    check_dimension::<3>(spec)?;
+    let element = match method {
+        Method::FEM_HEX8 => HexElement::Hex8,
+        Method::FEM_HEX20 => HexElement::Hex20,
+        _ => {
+            return Err(method.unsupported(
+                "dynamic manufactured 3D FEM solver",
+                &[Method::FEM_HEX8, Method::FEM_HEX20],
+            ))
+        }
+    };
+    let n = spec.cells;
+    let mesh = HexMesh::cuboid(SVector::zeros(), SVector::<f64, 3>::repeat(1.0), [n; 3], element)?;
+    // The effective tangent of a hyperelastic model is symmetric: LDLᵀ (LU its fallback), as
+    // in the static 3D study.
+    fem_solver_on(spec, mesh, LinearSolver::Ldlt)
+}
+
+/// The steps and failure of a run.
+fn outcome(
+    result: Result<Vec<StepReport>, (Vec<StepReport>, SolveError)>,
+) -> (Vec<StepReport>, Option<SolveError>) {
+    match result {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    }
+}
+
+/// Solve one plane dynamic manufactured analysis by `method` and measure its errors at the end.
 pub fn solve(spec: &DynamicManufacturedSpec, method: Method) -> Result<ManufacturedSolution, InputError> {
     spec.validate()?;
+    check_dimension::<2>(spec)?;
     let (result, points) = match method {
         Method::MaterialPoint(_) => {
-            let mut s = mpm_solver(spec, method)?;
+            let mut s = mpm_solver::<2>(spec, method)?;
             (s.run(), mpm_point_values(&s))
         }
         Method::FEM_Q4 | Method::FEM_Q8 => {
@@ -379,13 +520,38 @@ pub fn solve(spec: &DynamicManufacturedSpec, method: Method) -> Result<Manufactu
         }
         _ => return Err(method.unsupported("dynamic manufactured problem", &METHODS)),
     };
-    let (steps, failure) = match result {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) = outcome(result);
     let exact = ExactMotion::of(spec).at(spec.duration());
     let errors = failure.is_none().then(|| errors(&exact, &points));
     Ok(ManufacturedSolution {
+        steps,
+        failure,
+        points,
+        errors,
+    })
+}
+
+/// Solve one 3D dynamic manufactured analysis by `method` and measure its errors at the end.
+pub fn solve_3d(spec: &DynamicManufacturedSpec, method: Method) -> Result<Solution3, InputError> {
+    spec.validate()?;
+    check_dimension::<3>(spec)?;
+    let (result, points) = match method {
+        Method::MaterialPoint(_) => {
+            let mut s = mpm_solver::<3>(spec, method)?;
+            let r = s.run();
+            (r, point_values_3d(&s.points))
+        }
+        Method::FEM_HEX8 | Method::FEM_HEX20 => {
+            let mut f = fem_solver_3d(spec, method)?;
+            let r = f.run();
+            (r, super::manufactured3d::gauss_values_3d(&f))
+        }
+        _ => return Err(method.unsupported("dynamic manufactured 3D problem", &METHODS_3D)),
+    };
+    let (steps, failure) = outcome(result);
+    let exact = ExactMotion::of(spec).at_3d(spec.duration());
+    let errors = failure.is_none().then(|| errors_3d(&exact, &points));
+    Ok(Solution3 {
         steps,
         failure,
         points,

@@ -50,11 +50,14 @@ pub fn report_markdown(results: &DynamicResults, not_drawn: &[super::NotDrawn]) 
     if let Some(m) = &study.manufactured {
         let _ = writeln!(
             s,
-            "The unit square (plane strain, Hencky, E = {}, ν = {}, ρ₀ = {}) moved by a manufactured field with amplitude a(t) = A sin ωt, ω = πc, c = √(E/ρ₀) (Wallstedt & Guilkey 2008): axis-aligned x = X + a(t)(sin πX, sin πY) (A = {}), vortex x = c + R(a(t)(1 − 4r²)³)(X − c) (θ₀ = {}); rollers on every edge, the body force b₀ = ρ₀ẍ − Div P at the points, the exact velocity and acceleration at t = 0. Newmark β = {}, γ = {} over {} periods of T = 2/c = {}. Errors at the end against the field: displacement ‖x_p − x(X_p)‖/‖u(X_p)‖ and stress Σ‖σ_p − σ(X_p)‖ v_p0/(σ_max |Ω₀|), the form of eq (46). Rates are slopes of log(error) against log(h) (space sweeps) or log(Δt) (time sweeps).\n",
+            "The unit {} (Hencky, E = {}, ν = {}, ρ₀ = {}) moved by a manufactured field with amplitude a(t) = A sin ωt, ω = πc, c = √(E/ρ₀) (Wallstedt & Guilkey 2008): axis-aligned x = X + a(t)(sin πX, sin πY{}) (A = {}), vortex x = c + R(a(t)(1 − 4r²)³)(X − c){} (θ₀ = {}); rollers on every edge, the body force b₀ = ρ₀ẍ − Div P at the points, the exact velocity and acceleration at t = 0. Newmark β = {}, γ = {} over {} periods of T = 2/c = {}. Errors at the end against the field: displacement ‖x_p − x(X_p)‖/‖u(X_p)‖ and stress Σ‖σ_p − σ(X_p)‖ v_p0/(σ_max |Ω₀|), the form of eq (46). Rates are slopes of log(error) against log(h) (space sweeps) or log(Δt) (time sweeps).\n",
+            if m.dimension == 3 { "cube" } else { "square, plane strain" },
             m.young_modulus,
             m.poisson_ratio,
             m.density,
+            if m.dimension == 3 { ", sin πZ" } else { "" },
             m.amplitude.axis_aligned,
+            if m.dimension == 3 { " about z" } else { "" },
             m.amplitude.vortex,
             m.beta,
             m.gamma,

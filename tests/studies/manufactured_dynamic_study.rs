@@ -1,4 +1,4 @@
-//! The dynamic manufactured study (`studies/manufactured-dynamic.toml`), quick tier: every
+//! The dynamic manufactured studies (`studies/manufactured-dynamic.toml`, `-3d.toml`), quick tier: every
 //! check passes, the outputs re-render byte for byte, and a study file that gives both problem
 //! sections, or a manufactured sweep without its field, is refused with the key named.
 
@@ -99,4 +99,33 @@ fn a_dynamics_file_defines_one_problem_and_every_field() {
         text.replacen("field = \"axis-aligned\"\n", "", 1),
         "sweeps[0].field",
     );
+}
+
+/// The 3D study's quick tier: its checks (iGIMP and Hex8 displacement second order, Hex8
+/// stress first order on the unit cube) are evaluated and pass.
+#[test]
+fn every_dynamic_manufactured_3d_check_passes() {
+    let s = DynamicStudy::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/manufactured-dynamic-3d.toml"),
+    )
+    .expect("studies/manufactured-dynamic-3d.toml parses");
+    let r = run_in_memory(&s, "manufactured-dynamic-3d.toml", Tier::Quick)
+        .expect("an in-memory run")
+        .results;
+    assert_eq!(
+        r.checks.len(),
+        3,
+        "{:?}",
+        r.checks.iter().map(|c| &c.id).collect::<Vec<_>>()
+    );
+    for c in &r.checks {
+        assert_eq!(
+            c.pass,
+            Some(true),
+            "{}: {} (measured {:?})",
+            c.id,
+            c.description,
+            c.measured
+        );
+    }
 }

@@ -85,13 +85,20 @@ fn solve_bar(case: &DynamicCase, spec: &BarSpec) -> (DynamicRecord, History) {
 }
 
 fn solve_manufactured(case: &DynamicCase, spec: &DynamicManufacturedSpec) -> DynamicRecord {
-    let (mut solved, o) = match manufactured_dynamic::solve(spec, case.method) {
+    // (steps, failure, errors, points) of the plane or the 3D solve.
+    let solved = if spec.dimension == 3 {
+        manufactured_dynamic::solve_3d(spec, case.method)
+            .map(|o| (o.steps, o.failure, o.errors, o.points.len()))
+    } else {
+        manufactured_dynamic::solve(spec, case.method).map(|o| (o.steps, o.failure, o.errors, o.points.len()))
+    };
+    let (mut record, o) = match solved {
         Err(e) => (SolveRecord::rejected(e), None),
-        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
+        Ok(o) => (SolveRecord::of(&o.0, o.1.as_ref()), Some(o)),
     };
     let (time_steps, max_newton_iterations, steps_at_floor, steps_cut_back) =
-        step_counts(&mut solved, o.as_ref().map(|o| o.steps.as_slice()));
-    let errors = o.as_ref().and_then(|o| o.errors);
+        step_counts(&mut record, o.as_ref().map(|o| o.0.as_slice()));
+    let errors = o.as_ref().and_then(|o| o.2);
     DynamicRecord {
         id: case.id.clone(),
         method: case.method,
@@ -100,7 +107,7 @@ fn solve_manufactured(case: &DynamicCase, spec: &DynamicManufacturedSpec) -> Dyn
         elements: spec.cells,
         points_per_cell: spec.points_per_cell,
         steps_per_period: spec.steps_per_period,
-        solve: solved,
+        solve: record,
         time_steps,
         max_newton_iterations,
         steps_at_floor,
@@ -110,7 +117,7 @@ fn solve_manufactured(case: &DynamicCase, spec: &DynamicManufacturedSpec) -> Dyn
         measured_period: None,
         period_error: None,
         energy_drift: None,
-        points: o.as_ref().map_or(0, |o| o.points.len()),
+        points: o.as_ref().map_or(0, |o| o.3),
     }
 }
 

@@ -57,6 +57,17 @@ pub struct ManufacturedSection {
     pub beta: f64,
     #[serde(default = "half")]
     pub gamma: f64,
+    /// 2 (the unit square, plane strain) or 3 (the unit cube).
+    #[serde(default = "plane", skip_serializing_if = "is_plane")]
+    pub dimension: usize,
+}
+
+fn plane() -> usize {
+    2
+}
+
+fn is_plane(d: &usize) -> bool {
+    *d == 2
 }
 
 fn quarter() -> f64 {
@@ -278,7 +289,7 @@ impl CaseSpec {
         match self {
             CaseSpec::Bar(b) => (b.elements * b.points_per_cell * b.time_steps()) as f64,
             CaseSpec::Manufactured(m) => {
-                (m.cells * m.cells * m.points_per_cell * m.points_per_cell * m.time_steps()) as f64
+                ((m.cells * m.points_per_cell).pow(m.dimension as u32) * m.time_steps()) as f64
             }
         }
     }
@@ -311,8 +322,10 @@ pub const BAR_METHODS: [Method; 8] = [
     Method::FEM_QUADRATIC,
 ];
 
-/// The methods of a manufactured case: every material point family, Q4 and Q8.
+/// The methods of a plane manufactured case: every material point family, Q4 and Q8.
 pub const MANUFACTURED_METHODS: [Method; 8] = manufactured_dynamic::METHODS;
+/// The methods of a 3D manufactured case: every material point family, Hex8 and Hex20.
+pub const MANUFACTURED_METHODS_3D: [Method; 8] = crate::problems::manufactured3d::METHODS_3D;
 
 /// Most elements of one case (1D: cheap; a bound against typos).
 const MAX_ELEMENTS: i64 = 65_536;
@@ -419,6 +432,7 @@ impl DynamicStudy {
             mass,
             newton: self.newton.settings(),
             domain_update: Default::default(),
+            dimension: m.dimension,
         }))
     }
 
@@ -444,10 +458,10 @@ impl DynamicStudy {
 
     /// The methods a case of this study may use.
     pub fn methods(&self) -> &'static [Method] {
-        if self.bar.is_some() {
-            &BAR_METHODS
-        } else {
-            &MANUFACTURED_METHODS
+        match &self.manufactured {
+            None => &BAR_METHODS,
+            Some(m) if m.dimension == 3 => &MANUFACTURED_METHODS_3D,
+            Some(_) => &MANUFACTURED_METHODS,
         }
     }
 
@@ -515,6 +529,9 @@ impl DynamicStudy {
                 }
             }
             (None, Some(m)) => {
+                if !matches!(m.dimension, 2 | 3) {
+                    return Err(chk.err("manufactured.dimension", m.dimension, "must be 2 or 3"));
+                }
                 for (k, v) in [
                     ("manufactured.young_modulus", m.young_modulus),
                     ("manufactured.density", m.density),
