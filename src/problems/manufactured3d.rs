@@ -227,6 +227,38 @@ pub struct Solution3 {
     pub errors: Option<Errors>,
 }
 
+/// The material point solver of a 3D `spec` (any family): `points_per_cell`³ points per cell
+/// of the `cells`³ grid, rollers on the six faces, the dead load b₀ V_p0 on the points, ramped
+/// over the load steps.
+pub fn mpm_solver_3d(spec: &ManufacturedSpec, method: Method) -> Result<MpmSolver<3>, InputError> {
+    spec.validate()?;
+    if !method.uses_material_points() {
+        return Err(method.unsupported("3D manufactured material point solver", &Method::MATERIAL_POINT));
+    }
+    let exact = Exact3::of(spec);
+    let h = spec.element_size();
+    let grid = Grid::try_new([0.0; 3], [h; 3], [spec.cells; 3])?;
+    let ppc = spec.points_per_cell;
+    let points = MaterialPoints::fill_box(&grid, [0.0; 3], [1.0; 3], [ppc; 3], 1.0)?;
+    let point_loads = (0..points.len())
+        .map(|p| {
+            let x0 = points.position0[p];
+            (
+                p,
+                V3::from(exact.body_force([x0[0], x0[1], x0[2]])) * points.volume0[p],
+            )
+        })
+        .collect();
+    let fixed = rollers(3, |axis, value| grid.nodes_on_plane(axis, value));
+    let settings = mpm_settings(spec, method);
+    let loads = Loads {
+        gravity: V3::zeros(),
+        point_loads,
+    };
+    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    MpmSolver::try_new(grid, points, model, fixed, loads, settings)
+}
+
 /// Solve the 3D field of `spec` by `method`: iGIMP or MPM on `points_per_cell`³ points per
 /// cell of the `cells`³ grid, or Hex8 (2×2×2) / Hex20 (3×3×3) FEM on the same cells, the
 /// dead load carried by the points (Gauss points) as in 2D.
@@ -241,28 +273,9 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
     }
     let exact = Exact3::of(spec);
     let model = || LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio).map(Box::new);
-    let h = spec.element_size();
     let (steps, failure, values) = match method {
         Method::MaterialPoint(_) => {
-            let grid = Grid::try_new([0.0; 3], [h; 3], [spec.cells; 3])?;
-            let ppc = spec.points_per_cell;
-            let points = MaterialPoints::fill_box(&grid, [0.0; 3], [1.0; 3], [ppc; 3], 1.0)?;
-            let point_loads = (0..points.len())
-                .map(|p| {
-                    let x0 = points.position0[p];
-                    (
-                        p,
-                        V3::from(exact.body_force([x0[0], x0[1], x0[2]])) * points.volume0[p],
-                    )
-                })
-                .collect();
-            let fixed = rollers(3, |axis, value| grid.nodes_on_plane(axis, value));
-            let settings = mpm_settings(spec, method);
-            let loads = Loads {
-                gravity: V3::zeros(),
-                point_loads,
-            };
-            let mut solver = MpmSolver::try_new(grid, points, model()?, fixed, loads, settings)?;
+            let mut solver = mpm_solver_3d(spec, method)?;
             let (steps, failure) = match solver.run() {
                 Ok(s) => (s, None),
                 Err((s, e)) => (s, Some(e)),
