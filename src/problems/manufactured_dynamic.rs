@@ -126,14 +126,8 @@ impl DynamicManufacturedSpec {
                 format!("must be <= {max_cells} in {}D", self.dimension),
             ));
         }
-        require_count("points_per_cell", self.points_per_cell, 1)?;
-        if self.points_per_cell > 8 {
-            return Err(InputError::new(
-                "points_per_cell",
-                self.points_per_cell,
-                "must be <= 8",
-            ));
-        }
+        // Points per cell, the amplitude's range, the dimension and the material: the static
+        // field's checks (below).
         require_count("steps_per_period", self.steps_per_period, 1)?;
         require_positive("periods", self.periods)?;
         if self.time_steps() > 1_000_000 {

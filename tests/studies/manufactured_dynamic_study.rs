@@ -17,6 +17,20 @@ fn study() -> DynamicStudy {
     DynamicStudy::load(&path()).expect("studies/manufactured-dynamic.toml parses")
 }
 
+/// Every check evaluated and passed.
+fn assert_all_pass(checks: &[igimp::study::checks::CheckRecord]) {
+    for c in checks {
+        assert_eq!(
+            c.pass,
+            Some(true),
+            "{}: {} (measured {:?})",
+            c.id,
+            c.description,
+            c.measured
+        );
+    }
+}
+
 fn quick() -> &'static Run<DynamicStudy> {
     static RUN: OnceLock<Run<DynamicStudy>> = OnceLock::new();
     RUN.get_or_init(|| {
@@ -34,16 +48,7 @@ fn every_dynamic_manufactured_check_passes() {
         "{:?}",
         r.checks.iter().map(|c| &c.id).collect::<Vec<_>>()
     );
-    for c in &r.checks {
-        assert_eq!(
-            c.pass,
-            Some(true),
-            "{}: {} (measured {:?})",
-            c.id,
-            c.description,
-            c.measured
-        );
-    }
+    assert_all_pass(&r.checks);
     for c in &r.cases {
         assert_eq!(c.steps_cut_back, 0, "{}", c.id);
         assert!(
@@ -118,14 +123,5 @@ fn every_dynamic_manufactured_3d_check_passes() {
         "{:?}",
         r.checks.iter().map(|c| &c.id).collect::<Vec<_>>()
     );
-    for c in &r.checks {
-        assert_eq!(
-            c.pass,
-            Some(true),
-            "{}: {} (measured {:?})",
-            c.id,
-            c.description,
-            c.measured
-        );
-    }
+    assert_all_pass(&r.checks);
 }
