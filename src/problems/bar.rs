@@ -144,17 +144,34 @@ impl BarSpec {
     /// The solver: grid [0, L + h] (one cell beyond the free end, so that its domain stays
     /// inside), node 0 fixed, points with v_p = v₀ sin(πX_p / 2L).
     pub fn mpm_solver(&self, method: Method) -> Result<MpmSolver<1>, InputError> {
+        self.mpm_solver_in::<1>(method)
+    }
+
+    /// The bar in D = 1, 2 or 3 dimensions: in 2D and 3D a prism one cell of side h across
+    /// (h = L / elements), `points_per_cell` points per cell along every axis, the fixed end's
+    /// nodes held along x and rollers on the lateral faces. With ν = 0 the prism moves as the
+    /// 1D bar (a test compares them).
+    pub fn mpm_solver_in<const D: usize>(&self, method: Method) -> Result<MpmSolver<D>, InputError> {
         self.validate()?;
         let basis = method
             .basis()
             .ok_or_else(|| method.unsupported("bar", &Method::MATERIAL_POINT))?;
         let h = self.length / self.elements as f64;
-        let grid = Grid::try_new([0.0], [h], [self.elements + 1])?;
+        let cells = std::array::from_fn(|a| if a == 0 { self.elements + 1 } else { 1 });
+        let grid = Grid::try_new([0.0; D], [h; D], cells)?;
+        let upper = std::array::from_fn(|a| if a == 0 { self.length } else { h });
         let mut points =
-            MaterialPoints::fill_box(&grid, [0.0], [self.length], [self.points_per_cell], self.density)?;
+            MaterialPoints::fill_box(&grid, [0.0; D], upper, [self.points_per_cell; D], self.density)?;
         for p in 0..points.len() {
             let x = points.position0[p][0];
             points.velocity[p][0] = self.velocity * (PI * x / (2.0 * self.length)).sin();
+        }
+        let mut fixed: Vec<(usize, usize)> =
+            grid.nodes_on_plane(0, 0.0).into_iter().map(|n| (n, 0)).collect();
+        for a in 1..D {
+            for value in [0.0, h] {
+                fixed.extend(grid.nodes_on_plane(a, value).into_iter().map(|n| (n, a)));
+            }
         }
         let settings = MpmSettings {
             basis,
@@ -173,7 +190,7 @@ impl BarSpec {
             point_loads: vec![],
         };
         let model = Box::new(LinearElastic::try_new(self.young_modulus, 0.0)?);
-        MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, settings)
+        MpmSolver::try_new(grid, points, model, fixed, loads, settings)
     }
 }
 
@@ -297,12 +314,30 @@ fn solve_fem(spec: &BarSpec, element: LineElement) -> Result<BarOutcome, InputEr
 }
 
 fn solve_mpm(spec: &BarSpec, method: Method) -> Result<BarOutcome, InputError> {
-    let solver = spec.mpm_solver(method)?;
+    solve_mpm_in::<1>(spec, method)
+}
+
+/// The bar as a prism in `dimension` = 2 or 3 ([`BarSpec::mpm_solver_in`]) by a material point
+/// method; the measures are the 1D bar's, taken along x.
+pub fn solve_prism(spec: &BarSpec, method: Method, dimension: usize) -> Result<BarOutcome, InputError> {
+    match dimension {
+        2 => solve_mpm_in::<2>(spec, method),
+        3 => solve_mpm_in::<3>(spec, method),
+        _ => Err(InputError::new(
+            "dimension",
+            dimension,
+            "must be 2 or 3 for the prism",
+        )),
+    }
+}
+
+fn solve_mpm_in<const D: usize>(spec: &BarSpec, method: Method) -> Result<BarOutcome, InputError> {
+    let solver = spec.mpm_solver_in::<D>(method)?;
     let p0 = &solver.points.position0;
     let top = (0..p0.len())
         .max_by(|&a, &b| p0[a][0].total_cmp(&p0[b][0]))
         .expect("points");
-    let u = |s: &MpmSolver<1>, i: usize| s.points.position[i][0] - s.points.position0[i][0];
+    let u = |s: &MpmSolver<D>, i: usize| s.points.position[i][0] - s.points.position0[i][0];
     Ok(run_recorded(
         solver,
         MpmSolver::time,
