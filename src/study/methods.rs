@@ -2,8 +2,9 @@
 //! extrapolations, gathered from the `results.json` of the studies in one output folder into
 //! `<out>/methods/methods.json`, which `crate::render::methods` alone draws from.
 //!
-//! Nothing is solved here. The column-type and manufactured studies contribute their fitted
-//! rates (the `rates` array) and, for the overlay figures, each rate's errors against its
+//! Nothing is solved here. The column-type, manufactured and dynamics studies contribute their
+//! fitted rates (the `rates` array; a dynamics study's name the method inside `series` and say
+//! whether the grid or the time step was refined) and, for the overlay figures, each rate's errors against its
 //! resolution (the cases of its sweep); the compaction and cantilever studies contribute every
 //! method's end value against the study's reference at each element size and its GCI
 //! extrapolation. A series is one method in one group: the study, the measure and the keys
@@ -100,6 +101,7 @@ fn case_field(measure: &str) -> &str {
     match measure {
         "displacement" => "displacement_error",
         "stress" => "stress_error",
+        "period" => "period_error",
         m => m,
     }
 }
@@ -142,26 +144,41 @@ fn rates(name: &str, r: &Value, out: &mut MethodsResults) {
     let manufactured = r["study"]["problem"].as_str() == Some("manufactured");
     let mut groups: BTreeMap<(String, String), Group> = BTreeMap::new();
     for rate in r["rates"].as_array().into_iter().flatten() {
+        // A dynamics study's series (method, mass, points per cell) and refinement.
+        let series = &rate["series"];
         let (Some(sweep), Some(method), Some(measure)) = (
             rate["sweep"].as_str(),
-            method_of(&rate["method"]),
+            method_of(&rate["method"]).or_else(|| method_of(&series["method"])),
             rate["measure"].as_str(),
         ) else {
             continue;
         };
-        let ppc = rate["points_per_cell"].as_i64();
+        let ppc = rate["points_per_cell"]
+            .as_i64()
+            .or_else(|| series["points_per_cell"].as_i64());
+        let mass = series["mass"].as_str();
+        let in_time = rate["refinement"].as_str() == Some("time");
         let domain_update = rate["domain_update"].as_str();
-        let level_key = if manufactured { "cells" } else { "elements" };
-        let levels: Vec<f64> = rate[if manufactured {
+        let level_key = if manufactured {
+            "cells"
+        } else if in_time {
+            "steps_per_period"
+        } else {
+            "elements"
+        };
+        let levels_field = if manufactured {
             "cells_used"
+        } else if rate["levels_used"].is_array() {
+            "levels_used"
         } else {
             "elements_used"
-        }]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter_map(f)
-        .collect();
+        };
+        let levels: Vec<f64> = rate[levels_field]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(f)
+            .collect();
         // The sweep's cases of this series, for the overlay.
         let ids: Vec<&str> = r["sweep_cases"][sweep]
             .as_array()
@@ -176,6 +193,7 @@ fn rates(name: &str, r: &Value, out: &mut MethodsResults) {
             .filter(|c| c["points_per_cell"].as_i64() == ppc || method.is_fem())
             .filter(|c| rate["load"].is_null() || c["load"] == rate["load"])
             .filter(|c| domain_update.is_none() || c["domain_update"].as_str() == domain_update)
+            .filter(|c| mass.is_none() || c["mass"].as_str() == mass)
             .collect();
         let field = series_cases
             .first()
@@ -193,6 +211,12 @@ fn rates(name: &str, r: &Value, out: &mut MethodsResults) {
         }
         if let Some(d) = domain_update.filter(|d| *d != "stretch") {
             keys.push(format!("{d} domain update"));
+        }
+        if let Some(m) = mass.filter(|m| *m != "consistent") {
+            keys.push(format!("{m} mass"));
+        }
+        if in_time {
+            keys.push("time step refined".to_string());
         }
         let group = keys.join(", ");
         let expected = rate["expected"]
@@ -427,6 +451,60 @@ fn cantilever(name: &str, r: &Value, out: &mut MethodsResults) {
 mod tests {
     use super::*;
     use serde_json::json;
+
+    /// A dynamics results file: the method inside `series`, time sweeps grouped apart from
+    /// space sweeps (their levels are time steps, not elements), the lumped-mass series of the
+    /// same method kept apart from the consistent one.
+    #[test]
+    fn dynamics_rates_are_gathered_by_refinement_and_mass() {
+        let mut cases = vec![];
+        let mut rates = vec![];
+        let mut sweep_cases = serde_json::Map::new();
+        for (sw, refinement, mass) in [
+            ("space", "space", "consistent"),
+            ("time", "time", "consistent"),
+            ("time", "time", "lumped"),
+        ] {
+            for m in ["igimp", "cpdi", "tlmpm"] {
+                for (e, n) in [(8, 64), (16, 128)] {
+                    let (e, n) = if refinement == "space" { (e, 512) } else { (32, n) };
+                    let id = format!("{m}-{mass}-{sw}-e{e}-n{n}");
+                    cases.push(
+                        json!({"id": id, "method": m, "mass": mass, "elements": e, "steps_per_period": n,
+                                      "points_per_cell": 2, "displacement_error": 1.0 / (e * n) as f64}),
+                    );
+                    sweep_cases
+                        .entry(sw.to_string())
+                        .or_insert_with(|| json!([]))
+                        .as_array_mut()
+                        .unwrap()
+                        .push(json!(id));
+                }
+                rates.push(json!({"sweep": sw, "series": {"method": m, "mass": mass, "points_per_cell": 2},
+                                  "measure": "displacement", "refinement": refinement, "slope": 2.0,
+                                  "levels_used": if refinement == "space" { json!([8, 16]) } else { json!([64, 128]) }}));
+            }
+        }
+        let r = json!({"tier": "full", "study": {"problem": "dynamics"}, "cases": cases, "rates": rates,
+                       "sweep_cases": sweep_cases});
+        let out = collect(&[("vibrating-bar".into(), r)]);
+        assert_eq!(out.rates.len(), 9);
+        assert!(out.rates.iter().all(|x| x.method.uses_material_points()));
+        let titles: Vec<&str> = out.groups.iter().map(|g| g.title.as_str()).collect();
+        assert_eq!(out.groups.len(), 3, "{titles:?}");
+        let time = out
+            .groups
+            .iter()
+            .find(|g| g.title.contains("lumped mass"))
+            .expect("the lumped group");
+        assert!(
+            time.title.contains("time step refined") && time.x_desc == "steps_per_period",
+            "{}",
+            time.title
+        );
+        // Each lumped series holds its own two cases, not the consistent ones.
+        assert!(time.series.iter().all(|(_, p)| p.len() == 2), "{:?}", time.series);
+    }
 
     /// A column-type results file with three methods in one group and one FEM series: one
     /// rate row each, one overlay of the three material point methods, errors from the cases.
