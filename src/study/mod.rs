@@ -7,7 +7,8 @@
 //! `--vtk`, `--shard`/`--merge`) and [`engine::write_outputs`] writes the [`results::Envelope`]
 //! as `results.json`; [`crate::render`] reads only the results files. The kinds: [`column`](mod@column)
 //! (§5.1), [`compaction`] (§5.2), [`cantilever`] (§5.3), [`manufactured`] and the
-//! vibrating [`bar`] (dynamics); [`crate::kinds`] registers them.
+//! [`dynamics`] (the vibrating bar and the dynamic manufactured fields); [`crate::kinds`]
+//! registers them.
 //!
 //! Counts in the files are parsed as signed integers so that a negative value is reported by
 //! validation with its key and allowed range instead of as a type error.
