@@ -6,6 +6,17 @@ use crate::error::{SolveError, StepFailure};
 use crate::newton::{NewtonReport, NewtonSettings};
 use serde::{Deserialize, Serialize};
 
+/// The steps of a run and its failure, if any: the form the problems record a run in,
+/// whether it converged or stopped at a failing step.
+pub fn steps_and_failure(
+    result: Result<Vec<StepReport>, (Vec<StepReport>, SolveError)>,
+) -> (Vec<StepReport>, Option<SolveError>) {
+    match result {
+        Ok(s) => (s, None),
+        Err((s, e)) => (s, Some(e)),
+    }
+}
+
 /// One attempt at an increment inside a load step that needed cutbacks.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SubStep {

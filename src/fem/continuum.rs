@@ -220,15 +220,17 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
     /// inverted an element at the second step).
     fn check_lumped_masses(&self) -> Result<(), InputError> {
         let g = &self.gauss;
-        let k = self.mesh.element.nodes_per_element();
-        let mut lumped = vec![0.0; k];
-        for e in 0..self.mesh.num_elements() {
-            lumped.iter_mut().for_each(|m| *m = 0.0);
-            for q in (0..g.len()).filter(|&q| g.element[q] == e) {
-                let (n, _) = self.mesh.element.shape(&g.xi[q]);
-                for (m, n) in lumped.iter_mut().zip(n) {
-                    *m += n * g.mass[q];
-                }
+        let mut lumped = vec![0.0; self.mesh.element.nodes_per_element()];
+        // The Gauss points are stored element by element ([`Self::try_new`]): one pass, each
+        // element's row sums checked when its last point is added.
+        for q in 0..g.len() {
+            let e = g.element[q];
+            let (n, _) = self.mesh.element.shape(&g.xi[q]);
+            for (m, n) in lumped.iter_mut().zip(n) {
+                *m += n * g.mass[q];
+            }
+            if g.element.get(q + 1) == Some(&e) {
+                continue;
             }
             if let Some(a) = lumped.iter().position(|&m| m <= 0.0) {
                 return Err(InputError::new(
@@ -240,6 +242,7 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
                     ),
                 ));
             }
+            lumped.iter_mut().for_each(|m| *m = 0.0);
         }
         Ok(())
     }

@@ -20,7 +20,7 @@ use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
 use crate::grid::Grid;
 use crate::kinematics::{log_strain, PointState};
-use crate::load_stepping::{LoadStepping, StepReport};
+use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
 use crate::method::Method;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
 use crate::newton::NewtonSettings;
@@ -225,10 +225,7 @@ fn run_recorded<S: LoadStepping>(
         top_history.push((time(s), top(s)));
         energies.push(energy(s));
     });
-    let (steps, failure) = match result {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) = steps_and_failure(result);
     BarOutcome {
         steps,
         failure,

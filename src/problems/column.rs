@@ -13,7 +13,7 @@ use crate::fem::{
 };
 use crate::ghost::GhostSettings;
 use crate::grid::Grid;
-use crate::load_stepping::{LoadStepping, StepReport};
+use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
 use crate::newton::NewtonSettings;
 use crate::norms;
@@ -472,10 +472,8 @@ fn solve_mpm_3d(
 ) -> Result<ColumnOutcome, InputError> {
     let mut solver = spec.mpm_solver_3d(basis)?;
     observer(0, ColumnState::Mpm3(&solver));
-    let (steps, failure) = match solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Mpm3(s))) {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) =
+        steps_and_failure(solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Mpm3(s))));
     Ok(mpm_outcome(spec, &solver.points, 2, 0, steps, failure))
 }
 
@@ -655,10 +653,8 @@ fn solve_mpm_observed(
 ) -> Result<ColumnOutcome, InputError> {
     let mut solver = spec.mpm_solver(basis)?;
     observer(0, ColumnState::Mpm(&solver));
-    let (steps, failure) = match solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Mpm(s))) {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) =
+        steps_and_failure(solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Mpm(s))));
     Ok(mpm_outcome(spec, &solver.points, 0, 1, steps, failure))
 }
 
@@ -743,10 +739,8 @@ fn solve_fem_3d(
     };
     let mut fem = SolidFem::try_new(mesh, spec.density, spec.model()?, fixed, loads, settings)?;
     observer(0, ColumnState::Fem3(&fem));
-    let (steps, failure) = match fem.run_observed(&mut |s, r| observer(r.step, ColumnState::Fem3(s))) {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) =
+        steps_and_failure(fem.run_observed(&mut |s, r| observer(r.step, ColumnState::Fem3(s))));
     let g = &fem.gauss;
     let records = (0..g.len())
         .map(|p| {
@@ -784,10 +778,8 @@ pub fn solve_fem_observed(
 ) -> Result<ColumnOutcome, InputError> {
     let mut solver = spec.fem_solver(element)?;
     observer(0, ColumnState::Fem(&solver));
-    let (steps, failure) = match solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Fem(s))) {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) =
+        steps_and_failure(solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Fem(s))));
     let records = fem_records(&solver);
     let top = solver.displacement(solver.mesh.num_nodes() - 1);
     Ok(ColumnOutcome::from_records(spec, records, top, steps, failure))

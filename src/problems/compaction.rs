@@ -17,7 +17,7 @@ use crate::fem::{
 use crate::ghost::{GhostFaces, GhostSettings};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
-use crate::load_stepping::{LoadStepping, StepReport};
+use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
 use crate::method::Method;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, WeakNodeTreatment};
 use crate::newton::NewtonSettings;
@@ -252,10 +252,7 @@ pub struct CompactionOutcome {
 /// Run the compaction problem with material points.
 pub fn solve_mpm(spec: &CompactionSpec) -> Result<CompactionOutcome, InputError> {
     let mut solver = spec.mpm_solver()?;
-    let (steps, failure) = match solver.run() {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) = steps_and_failure(solver.run());
     let pts = &solver.points;
     // Bottom-right point: lowest row, largest x.
     let min_y = pts.position0.iter().map(|x| x[1]).fold(f64::INFINITY, f64::min);
@@ -377,10 +374,7 @@ fn run_fem_block<const D: usize, E: ElementFamily<D>>(
     corner: usize,
 ) -> FemOutcome {
     let elements = fem.mesh.num_elements();
-    let (steps, failure) = match fem.run() {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) = steps_and_failure(fem.run());
     FemOutcome {
         steps,
         failure,
@@ -543,10 +537,7 @@ impl CompactionSpec {
 /// slots and σ_zz as the vertical stress.
 pub fn solve_mpm_3d(spec: &CompactionSpec) -> Result<CompactionOutcome, InputError> {
     let mut solver = spec.mpm_solver_3d()?;
-    let (steps, failure) = match solver.run() {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) = steps_and_failure(solver.run());
     let pts = &solver.points;
     let lowest = |a: usize| pts.position0.iter().map(|x| x[a]).fold(f64::INFINITY, f64::min);
     let (y0, z0) = (lowest(1), lowest(2));

@@ -25,7 +25,7 @@ use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::fem::{ElementFamily, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
-use crate::load_stepping::{LoadStepping, StepReport};
+use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
 use crate::method::Method;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
 use crate::newton::NewtonSettings;
@@ -546,10 +546,7 @@ pub fn mpm_solver(spec: &ManufacturedSpec, method: Method) -> Result<MpmSolver<2
 
 fn solve_mpm(spec: &ManufacturedSpec, method: Method) -> Result<Run, InputError> {
     let mut solver = mpm_solver(spec, method)?;
-    let (steps, failure) = match solver.run() {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) = steps_and_failure(solver.run());
     Ok((steps, failure, mpm_point_values(&solver)))
 }
 
@@ -619,10 +616,7 @@ pub fn fem_solver(spec: &ManufacturedSpec, method: Method) -> Result<PlaneFem, I
 
 fn solve_fem(spec: &ManufacturedSpec, method: Method) -> Result<Run, InputError> {
     let mut fem = fem_solver(spec, method)?;
-    let (steps, failure) = match fem.run() {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    };
+    let (steps, failure) = steps_and_failure(fem.run());
     Ok((steps, failure, fem_point_values(&fem)))
 }
 

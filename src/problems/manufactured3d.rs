@@ -21,7 +21,7 @@ use crate::error::{InputError, SolveError};
 use crate::fem::{ElementFamily, FemLoads, HexElement, HexMesh, PlaneFemSettings, SolidFem};
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
-use crate::load_stepping::{LoadStepping, StepReport};
+use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
 use crate::method::Method;
 use crate::mpm::{Loads, MpmSolver};
 use crate::particles::MaterialPoints;
@@ -276,10 +276,7 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
     let (steps, failure, values) = match method {
         Method::MaterialPoint(_) => {
             let mut solver = mpm_solver_3d(spec, method)?;
-            let (steps, failure) = match solver.run() {
-                Ok(s) => (s, None),
-                Err((s, e)) => (s, Some(e)),
-            };
+            let (steps, failure) = steps_and_failure(solver.run());
             let values = point_values_3d(&solver.points);
             (steps, failure, values)
         }
@@ -316,10 +313,7 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
                 linear_solver: LinearSolver::Ldlt,
             };
             let mut fem = SolidFem::try_new(mesh, 1.0, model()?, fixed, loads, settings)?;
-            let (steps, failure) = match fem.run() {
-                Ok(s) => (s, None),
-                Err((s, e)) => (s, Some(e)),
-            };
+            let (steps, failure) = steps_and_failure(fem.run());
             let values = gauss_values_3d(&fem);
             (steps, failure, values)
         }

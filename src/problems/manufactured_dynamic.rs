@@ -22,13 +22,12 @@
 //! (displacement and stress at the points) at the end, against the motion at that time.
 
 use super::manufactured::{
-    errors, fem_point_values, mpm_point_values, rollers, Exact, Field, ManufacturedSolution,
+    errors, fem_point_values, mpm_point_values, mpm_settings, rollers, Exact, Field, ManufacturedSolution,
 };
 use super::manufactured3d::{errors_3d, point_values_3d, Exact3, Solution3, METHODS_3D};
 use crate::basis::DomainUpdate;
 use crate::constitutive::{lame, LinearElastic};
 use crate::dynamics::{BodyForce, LoadHistory, MassMatrix, Newmark};
-use crate::error::SolveError;
 use crate::error::{require_count, require_positive, InputError};
 use crate::fem::{
     ContinuumFem, ElementFamily, ElementMesh, FemLoads, HexElement, HexMesh, PlaneFemSettings, PlaneMesh,
@@ -36,7 +35,7 @@ use crate::fem::{
 };
 use crate::grid::Grid;
 use crate::linear::LinearSolver;
-use crate::load_stepping::{LoadStepping, StepReport};
+use crate::load_stepping::{steps_and_failure, LoadStepping};
 use crate::method::Method;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
 use crate::newton::NewtonSettings;
@@ -299,18 +298,6 @@ impl ExactMotion {
         (v, acc)
     }
 
-    /// ẋ(X, t) (plane).
-    pub fn velocity(&self, x: [f64; 2], t: f64) -> [f64; 2] {
-        let v = self.motion_rates(&SVector::<f64, 2>::new(x[0], x[1]), t).0;
-        [v[0], v[1]]
-    }
-
-    /// ẍ(X, t) (plane).
-    pub fn acceleration(&self, x: [f64; 2], t: f64) -> [f64; 2] {
-        let a = self.motion_rates(&SVector::<f64, 2>::new(x[0], x[1]), t).1;
-        [a[0], a[1]]
-    }
-
     /// The 3D field at time t (position, stresses, −Div P at amplitude a(t)).
     pub fn at_3d(&self, t: f64) -> Exact3 {
         Exact3 {
@@ -334,12 +321,6 @@ impl ExactMotion {
         acc * self.density + minus_div
     }
 
-    /// b₀(X, t) (plane).
-    pub fn body_force(&self, x: [f64; 2], t: f64) -> [f64; 2] {
-        let b = self.body_force_at(&SVector::<f64, 2>::new(x[0], x[1]), t);
-        [b[0], b[1]]
-    }
-
     /// The body force as the solvers take it.
     pub fn body_force_field<const D: usize>(&self) -> BodyForce<D> {
         let m = *self;
@@ -357,12 +338,12 @@ pub fn mpm_solver<const D: usize>(
 ) -> Result<MpmSolver<D>, InputError> {
     spec.validate()?;
     check_dimension::<D>(spec)?;
-    let basis = method.basis().ok_or_else(|| {
-        method.unsupported(
+    if !method.uses_material_points() {
+        return Err(method.unsupported(
             "dynamic manufactured material point solver",
             &Method::MATERIAL_POINT,
-        )
-    })?;
+        ));
+    }
     let exact = ExactMotion::of(spec);
     let h = spec.element_size();
     let grid = Grid::<D>::try_new([0.0; D], [h; D], [spec.cells; D])?;
@@ -374,17 +355,11 @@ pub fn mpm_solver<const D: usize>(
         points.acceleration[p] = a;
     }
     let fixed = rollers(D, |axis, value| grid.nodes_on_plane(axis, value));
+    // The static field's settings (its family, no treatment of nearly empty cells), made
+    // dynamic.
     let settings = MpmSettings {
-        basis,
-        domain_update: spec.domain_update,
-        newton: spec.newton,
-        load_steps: spec.time_steps(),
-        weak_node_tolerance: 0.0,
-        weak_node_treatment: Default::default(),
-        volume_update: Default::default(),
-        linear_solver: LinearSolver::Lu,
-        ghost: Default::default(),
         dynamics: Some(spec.newmark()),
+        ..mpm_settings(&spec.static_spec(), method)
     };
     let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
     let loads = Loads {
@@ -489,16 +464,6 @@ pub fn fem_solver_3d(
     fem_solver_on(spec, mesh, LinearSolver::Ldlt)
 }
 
-/// The steps and failure of a run.
-fn outcome(
-    result: Result<Vec<StepReport>, (Vec<StepReport>, SolveError)>,
-) -> (Vec<StepReport>, Option<SolveError>) {
-    match result {
-        Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
-    }
-}
-
 /// Solve one plane dynamic manufactured analysis by `method` and measure its errors at the end.
 pub fn solve(spec: &DynamicManufacturedSpec, method: Method) -> Result<ManufacturedSolution, InputError> {
     spec.validate()?;
@@ -514,7 +479,7 @@ pub fn solve(spec: &DynamicManufacturedSpec, method: Method) -> Result<Manufactu
         }
         _ => return Err(method.unsupported("dynamic manufactured problem", &METHODS)),
     };
-    let (steps, failure) = outcome(result);
+    let (steps, failure) = steps_and_failure(result);
     let exact = ExactMotion::of(spec).at(spec.duration());
     let errors = failure.is_none().then(|| errors(&exact, &points));
     Ok(ManufacturedSolution {
@@ -542,7 +507,7 @@ pub fn solve_3d(spec: &DynamicManufacturedSpec, method: Method) -> Result<Soluti
         }
         _ => return Err(method.unsupported("dynamic manufactured 3D problem", &METHODS_3D)),
     };
-    let (steps, failure) = outcome(result);
+    let (steps, failure) = steps_and_failure(result);
     let exact = ExactMotion::of(spec).at_3d(spec.duration());
     let errors = failure.is_none().then(|| errors_3d(&exact, &points));
     Ok(Solution3 {
@@ -574,7 +539,7 @@ mod tests {
                 for t in [0.0, 0.37, 1.1] {
                     let pos = |t: f64| m.at(t).position(x);
                     let (p0, pm, pp) = (pos(t), pos(t - dt), pos(t + dt));
-                    let (v, a) = (m.velocity(x, t), m.acceleration(x, t));
+                    let (v, a) = m.motion_rates(&SVector::<f64, 2>::from(x), t);
                     for i in 0..2 {
                         let fd_v = (pp[i] - pm[i]) / (2.0 * dt);
                         let fd_a = (pp[i] - 2.0 * p0[i] + pm[i]) / (dt * dt);
@@ -606,7 +571,8 @@ mod tests {
         };
         let m = ExactMotion::of(&spec);
         for x in [[0.3, 0.4], [0.55, 0.62]] {
-            let (b, a) = (m.body_force(x, 0.0), m.acceleration(x, 0.0));
+            let x = SVector::<f64, 2>::from(x);
+            let (b, a) = (m.body_force_at(&x, 0.0), m.motion_rates(&x, 0.0).1);
             for i in 0..2 {
                 assert!((b[i] - 2.0 * a[i]).abs() < 1e-12, "{b:?} {a:?}");
             }

@@ -42,26 +42,34 @@ fn every_bar_check_passes() {
     }
 }
 
-/// Rendering twice from the written results gives the same bytes, and the history figure is
-/// drawn from `histories.json`.
-#[test]
-fn bar_outputs_rerender_byte_identically() {
+/// A dynamics study's quick run written and rendered twice: nothing left undrawn, and `files`
+/// the same bytes both times.
+pub fn assert_rerenders_byte_identically(run: &Run<DynamicStudy>, files: &[&str]) {
     let tmp = tempfile::tempdir().unwrap();
-    let dir = write_outputs(tmp.path(), quick()).unwrap();
+    let dir = write_outputs(tmp.path(), run).unwrap();
     let first = render(&dir).unwrap();
     assert!(first.not_drawn.is_empty(), "{:?}", first.not_drawn);
     let read = |f: &str| std::fs::read(dir.join(f)).unwrap();
-    let files = [
-        "report.md",
-        "history.svg",
-        "time-displacement.svg",
-        "space-displacement.svg",
-    ];
     let before: Vec<Vec<u8>> = files.iter().map(|f| read(f)).collect();
     render(&dir).unwrap();
     for (f, b) in files.iter().zip(before) {
         assert_eq!(read(f), b, "{f} changed on re-render");
     }
+}
+
+/// Rendering twice from the written results gives the same bytes, and the history figure is
+/// drawn from `histories.json`.
+#[test]
+fn bar_outputs_rerender_byte_identically() {
+    assert_rerenders_byte_identically(
+        quick(),
+        &[
+            "report.md",
+            "history.svg",
+            "time-displacement.svg",
+            "space-displacement.svg",
+        ],
+    );
 }
 
 /// γ = 0.6 damps the response and makes Newmark first order in Δt: the iGIMP time-rate band

@@ -2,9 +2,8 @@
 //! check passes, the outputs re-render byte for byte, and a study file that gives both problem
 //! sections, or a manufactured sweep without its field, is refused with the key named.
 
-use igimp::render::dynamics::render;
 use igimp::study::dynamics::DynamicStudy;
-use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
+use igimp::study::engine::{run_in_memory, Run, StudyKind};
 use igimp::study::Tier;
 use std::path::Path;
 use std::sync::OnceLock;
@@ -62,21 +61,14 @@ fn every_dynamic_manufactured_check_passes() {
 /// Rendering twice from the written results gives the same bytes.
 #[test]
 fn dynamic_manufactured_outputs_rerender_byte_identically() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = write_outputs(tmp.path(), quick()).unwrap();
-    let first = render(&dir).unwrap();
-    assert!(first.not_drawn.is_empty(), "{:?}", first.not_drawn);
-    let read = |f: &str| std::fs::read(dir.join(f)).unwrap();
-    let files = [
-        "report.md",
-        "axis-space-displacement.svg",
-        "axis-time-displacement.svg",
-    ];
-    let before: Vec<Vec<u8>> = files.iter().map(|f| read(f)).collect();
-    render(&dir).unwrap();
-    for (f, b) in files.iter().zip(before) {
-        assert_eq!(read(f), b, "{f} changed on re-render");
-    }
+    crate::bar_study::assert_rerenders_byte_identically(
+        quick(),
+        &[
+            "report.md",
+            "axis-space-displacement.svg",
+            "axis-time-displacement.svg",
+        ],
+    );
 }
 
 /// A file with both `[bar]` and `[manufactured]`, and a manufactured sweep without `field`,

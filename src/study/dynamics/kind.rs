@@ -28,21 +28,48 @@ fn solve_case(case: &DynamicCase) -> (DynamicRecord, History) {
     }
 }
 
-/// The step counts of a solve's record before its histories are cut to the last step's:
-/// (time steps, most Newton iterations of a step, steps accepted at their floor, steps cut back).
-fn step_counts(solved: &mut SolveRecord, steps: Option<&[StepReport]>) -> (usize, usize, usize, usize) {
-    let time_steps = solved.steps.len();
+/// The record of a case from its solve (status, failure, the last step's history) and the
+/// steps behind it, with what every problem records: the case's discretisation, the step
+/// counts (time steps, most Newton iterations of a step, steps accepted at their floor, steps
+/// cut back) and the point count; the problem fills in its measures.
+fn base_record(
+    case: &DynamicCase,
+    mut solve: SolveRecord,
+    steps: Option<&[StepReport]>,
+    points: usize,
+) -> DynamicRecord {
+    let time_steps = solve.steps.len();
     let max_newton_iterations = steps
         .and_then(|s| s.iter().map(|s| s.newton.iterations()).max())
         .unwrap_or(0);
-    let steps_at_floor = solved
+    let steps_at_floor = solve
         .steps
         .iter()
         .filter(|s| s.accepted_at_floor.is_some())
         .count();
     let steps_cut_back = steps.map_or(0, |s| s.iter().filter(|s| s.cutbacks() > 0).count());
-    solved.steps.drain(..time_steps.saturating_sub(1));
-    (time_steps, max_newton_iterations, steps_at_floor, steps_cut_back)
+    solve.steps.drain(..time_steps.saturating_sub(1));
+    let l = case.spec.levels();
+    DynamicRecord {
+        id: case.id.clone(),
+        method: case.method,
+        field: l.field,
+        mass: l.mass,
+        elements: l.elements,
+        points_per_cell: l.points_per_cell,
+        steps_per_period: l.steps_per_period,
+        solve,
+        time_steps,
+        max_newton_iterations,
+        steps_at_floor,
+        steps_cut_back,
+        displacement_error: None,
+        stress_error: None,
+        measured_period: None,
+        period_error: None,
+        energy_drift: None,
+        points,
+    }
 }
 
 fn finite(x: f64) -> Option<f64> {
@@ -50,38 +77,28 @@ fn finite(x: f64) -> Option<f64> {
 }
 
 fn solve_bar(case: &DynamicCase, spec: &BarSpec) -> (DynamicRecord, History) {
-    let (mut solved, o) = match bar::solve(spec, case.method) {
-        Err(e) => (SolveRecord::rejected(e), None),
-        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
+    let o = match bar::solve(spec, case.method) {
+        Err(e) => return (base_record(case, SolveRecord::rejected(e), None, 0), vec![]),
+        Ok(o) => o,
     };
-    let (time_steps, max_newton_iterations, steps_at_floor, steps_cut_back) =
-        step_counts(&mut solved, o.as_ref().map(|o| o.steps.as_slice()));
-    let conv = o.as_ref().filter(|o| o.failure.is_none());
+    let base = base_record(
+        case,
+        SolveRecord::of(&o.steps, o.failure.as_ref()),
+        Some(&o.steps),
+        o.points.len(),
+    );
+    let conv = Some(&o).filter(|o| o.failure.is_none());
     let (exact, end) = (spec.period(), spec.duration());
     let rec = DynamicRecord {
-        id: case.id.clone(),
-        method: case.method,
-        field: None,
-        mass: spec.mass,
-        elements: spec.elements,
-        points_per_cell: spec.points_per_cell,
-        steps_per_period: spec.steps_per_period,
-        solve: solved,
-        time_steps,
-        max_newton_iterations,
-        steps_at_floor,
-        steps_cut_back,
         displacement_error: conv.and_then(|o| finite(o.displacement_error(spec, end))),
-        stress_error: None,
         measured_period: conv.and_then(|o| o.measured_period),
         period_error: conv
             .and_then(|o| o.measured_period)
             .map(|t| (t - exact).abs() / exact),
         energy_drift: conv.and_then(|o| finite(o.energy_drift())),
-        points: o.as_ref().map_or(0, |o| o.points.len()),
+        ..base
     };
-    let history = o.map_or(vec![], |o| o.top_history.iter().map(|&(t, u)| [t, u]).collect());
-    (rec, history)
+    (rec, o.top_history.iter().map(|&(t, u)| [t, u]).collect())
 }
 
 fn solve_manufactured(case: &DynamicCase, spec: &DynamicManufacturedSpec) -> DynamicRecord {
@@ -92,32 +109,19 @@ fn solve_manufactured(case: &DynamicCase, spec: &DynamicManufacturedSpec) -> Dyn
     } else {
         manufactured_dynamic::solve(spec, case.method).map(|o| (o.steps, o.failure, o.errors, o.points.len()))
     };
-    let (mut record, o) = match solved {
-        Err(e) => (SolveRecord::rejected(e), None),
-        Ok(o) => (SolveRecord::of(&o.0, o.1.as_ref()), Some(o)),
+    let (steps, failure, errors, points) = match solved {
+        Err(e) => return base_record(case, SolveRecord::rejected(e), None, 0),
+        Ok(o) => o,
     };
-    let (time_steps, max_newton_iterations, steps_at_floor, steps_cut_back) =
-        step_counts(&mut record, o.as_ref().map(|o| o.0.as_slice()));
-    let errors = o.as_ref().and_then(|o| o.2);
     DynamicRecord {
-        id: case.id.clone(),
-        method: case.method,
-        field: Some(spec.field),
-        mass: spec.mass,
-        elements: spec.cells,
-        points_per_cell: spec.points_per_cell,
-        steps_per_period: spec.steps_per_period,
-        solve: record,
-        time_steps,
-        max_newton_iterations,
-        steps_at_floor,
-        steps_cut_back,
         displacement_error: errors.and_then(|e| finite(e.displacement)),
         stress_error: errors.and_then(|e| finite(e.stress)),
-        measured_period: None,
-        period_error: None,
-        energy_drift: None,
-        points: o.as_ref().map_or(0, |o| o.3),
+        ..base_record(
+            case,
+            SolveRecord::of(&steps, failure.as_ref()),
+            Some(&steps),
+            points,
+        )
     }
 }
 

@@ -294,6 +294,27 @@ impl CaseSpec {
         }
     }
 
+    /// What names the case in its sweep: its field (manufactured), mass matrix, elements
+    /// (cells per side), points per cell and time steps per period.
+    pub fn levels(&self) -> CaseLevels {
+        match self {
+            CaseSpec::Bar(b) => CaseLevels {
+                field: None,
+                mass: b.mass,
+                elements: b.elements,
+                points_per_cell: b.points_per_cell,
+                steps_per_period: b.steps_per_period,
+            },
+            CaseSpec::Manufactured(m) => CaseLevels {
+                field: Some(m.field),
+                mass: m.mass,
+                elements: m.cells,
+                points_per_cell: m.points_per_cell,
+                steps_per_period: m.steps_per_period,
+            },
+        }
+    }
+
     /// The period of the motion: the bar's 4L/c, the manufactured forcing's 2/c.
     pub fn period(&self) -> f64 {
         match self {
@@ -308,6 +329,16 @@ struct SweepPlan {
     methods: Vec<Method>,
     elements: Vec<i64>,
     steps_per_period: Vec<i64>,
+}
+
+/// The discretisation of one case ([`CaseSpec::levels`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CaseLevels {
+    pub field: Option<Field>,
+    pub mass: MassMatrix,
+    pub elements: usize,
+    pub points_per_cell: usize,
+    pub steps_per_period: usize,
 }
 
 /// The methods a bar case can use: every material point family and the line elements.
@@ -438,16 +469,13 @@ impl DynamicStudy {
 
     /// `<method>[-<field>]-<mass>-e<elements>-p<ppc>-n<steps per period>`.
     pub fn case_id(method: Method, spec: &CaseSpec) -> String {
-        let (field, mass, elements, ppc, steps) = match spec {
-            CaseSpec::Bar(b) => (None, b.mass, b.elements, b.points_per_cell, b.steps_per_period),
-            CaseSpec::Manufactured(m) => (
-                Some(m.field),
-                m.mass,
-                m.cells,
-                m.points_per_cell,
-                m.steps_per_period,
-            ),
-        };
+        let CaseLevels {
+            field,
+            mass,
+            elements,
+            points_per_cell: ppc,
+            steps_per_period: steps,
+        } = spec.levels();
         let mass = match mass {
             MassMatrix::Consistent => "cm",
             MassMatrix::Lumped => "lm",
