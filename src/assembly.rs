@@ -214,14 +214,19 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         Ok(())
     }
 
-    /// f += M a₁ with a₁ = Δu/(βΔt²) − ã per nodal dof: consistent, Σ_p m_p S_ap (Σ_b S_bp a₁_b);
-    /// lumped, (Σ_p m_p S_ap) a₁_a. Fixed dofs take theirs into the reactions.
+    /// f += M a₁ with a₁ = Δu/(βΔt²) − ã per nodal dof (generalised-α: M (c_m a₁ + c_a a₀),
+    /// [`crate::dynamics::GeneralizedAlpha`]): consistent, Σ_p m_p S_ap (Σ_b S_bp a₁_b); lumped,
+    /// (Σ_p m_p S_ap) a₁_a. Fixed dofs take theirs into the reactions.
     fn add_inertia_residual(&mut self, inertia: &Inertia<'_>, f_int: &mut [f64]) {
         let (du, dofs, fixed) = (&*self.du_nodal, self.dofs, &mut *self.fixed_forces);
         mass_times(
             self.table,
             inertia,
-            |dof| inertia.step.acceleration_after(du[dof], inertia.predictor[dof]),
+            |dof| {
+                inertia
+                    .step
+                    .inertia_acceleration(du[dof], inertia.predictor[dof], inertia.acceleration[dof])
+            },
             |dof, f| match dofs.eq(dof) {
                 Some(e) => f_int[e] += f,
                 None => fixed[dof] += f,
@@ -358,7 +363,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                     // The inertia term's α m_p S_a S_b δ_ik (consistent mass).
                     let mass = inertia
                         .filter(|i| i.mass == MassMatrix::Consistent)
-                        .map_or(0.0, |i| i.step.mass_factor() * i.point_masses[p]);
+                        .map_or(0.0, |i| i.step.tangent_mass_factor() * i.point_masses[p]);
                     let weights = table.point(p).1;
                     // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V.
                     for kb in 0..nodes.len() {
@@ -463,7 +468,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                     for a in 0..D {
                         if let Some(e) = dofs.eq(node * D + a) {
                             self.matrix
-                                .add(e, e, i.step.mass_factor() * i.point_masses[p] * w);
+                                .add(e, e, i.step.tangent_mass_factor() * i.point_masses[p] * w);
                         }
                     }
                 }
@@ -574,6 +579,34 @@ pub struct StepInput<'a, const D: usize> {
     pub ghost: Option<&'a GhostOperator<D>>,
     /// The inertia term of a dynamic step; `None`: quasi-static.
     pub inertia: Option<Inertia<'a>>,
+    /// Generalised-α only: the point and nodal forces at the step's start t₀, for its term
+    /// c_f (f_int(u₀) − f_ext(t₀)) ([`crate::dynamics::GeneralizedAlpha`]); `None`: Newmark.
+    pub start_forces: Option<StartForces<'a, D>>,
+}
+
+/// The external forces at the start of a step, as [`StepInput`] gives those at its end.
+#[derive(Debug, Clone, Copy)]
+pub struct StartForces<'a, const D: usize> {
+    pub point_forces: &'a [SVector<f64, D>],
+    pub nodal_forces: &'a [(usize, f64)],
+}
+
+/// f_ext of `point_forces` (mapped with the weights, eq 40) and `nodal_forces`, gathered in
+/// equation order.
+fn external_force<const D: usize>(
+    table: &SupportTable<D>,
+    dofs: &DofMap,
+    point_forces: &[SVector<f64, D>],
+    nodal_forces: &[(usize, f64)],
+) -> Vec<f64> {
+    let mut nodal = vec![0.0; dofs.num_dofs()];
+    map_point_forces(table, point_forces, &mut nodal);
+    for &(dof, force) in nodal_forces {
+        nodal[dof] += force;
+    }
+    let mut f_ext = vec![0.0; dofs.len()];
+    dofs.gather_forces(&nodal, &mut f_ext);
+    f_ext
 }
 
 impl<const D: usize> StepWorkspace<D> {
@@ -614,20 +647,49 @@ impl<const D: usize> StepWorkspace<D> {
             }
         }
         crate::profile::charge(crate::profile::Phase::Setup, start);
-        let mut nodal = vec![0.0; dofs.num_dofs()];
-        map_point_forces(&self.table, input.point_forces, &mut nodal);
-        for &(dof, force) in input.nodal_forces {
-            nodal[dof] += force;
+        let mut f_ext = external_force(&self.table, &dofs, input.point_forces, input.nodal_forces);
+        if let (Some(i), Some(start)) = (input.inertia, input.start_forces) {
+            let weight = i.step.start_force_weight();
+            if weight != 0.0 {
+                // f_ext(t₁) − c_f (f_int(u₀) − f_ext(t₀)): f_int(u₀) is the internal force at a
+                // zero increment (the committed stresses on this step's grid or mesh).
+                let f_ext0 = external_force(&self.table, &dofs, start.point_forces, start.nodal_forces);
+                let mut f_int0 = vec![0.0; dofs.len()];
+                self.du_nodal.clear();
+                self.du_nodal.resize(dofs.num_dofs(), 0.0);
+                let mut at_rest = LoadStepSystem {
+                    model: input.model,
+                    states: input.states,
+                    table: &self.table,
+                    dofs: &dofs,
+                    f_ext: &f_ext0,
+                    matrix: &mut self.matrix,
+                    trials: &mut self.trials,
+                    du_nodal: &mut self.du_nodal,
+                    ghost: input.ghost,
+                    fixed_forces: &mut self.fixed_forces,
+                    linearised: None,
+                    inertia: None,
+                    dynamic_reference: None,
+                };
+                if at_rest.assemble_residual(&mut f_int0).is_ok() {
+                    for ((f, fi), fe) in f_ext.iter_mut().zip(&f_int0).zip(&f_ext0) {
+                        *f -= weight * (fi - fe);
+                    }
+                } else {
+                    // The committed states evaluated at no increment cannot fail unless they
+                    // are already invalid; Newton's first evaluation reports that failure.
+                    f_ext.iter_mut().for_each(|f| *f = f64::NAN);
+                }
+            }
         }
-        let mut f_ext = vec![0.0; dofs.len()];
-        dofs.gather_forces(&nodal, &mut f_ext);
         let reference = input.inertia.map(|i| {
             let mut load = f_ext.clone();
             let mut start = vec![0.0; dofs.len()];
             mass_times(
                 &self.table,
                 &i,
-                |dof| i.predictor[dof],
+                |dof| i.step.inertia_predictor(i.predictor[dof], i.acceleration[dof]),
                 |dof, f| {
                     if let Some(e) = dofs.eq(dof) {
                         load[e] += f;

@@ -87,6 +87,57 @@ pub struct Newmark {
     pub mass: MassMatrix,
     #[serde(default)]
     pub load: LoadHistory,
+    /// Generalised-α (Chung & Hulbert 1993) instead of plain Newmark: the spectral radius ρ∞ ∈
+    /// [0, 1] of the scheme at ωΔt → ∞, from which α_m, α_f, β and γ follow ([`GeneralizedAlpha`]);
+    /// `beta` and `gamma` must then be left at their defaults. `None`: Newmark with `beta`,
+    /// `gamma`. Not serialised when absent, so that Newmark analyses keep their keys.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho_infinity: Option<f64>,
+}
+
+/// The generalised-α method of Chung & Hulbert (*J. Appl. Mech.* 60 (1993) 371), eqs 2–3
+/// and 25: the equation of motion is balanced at the weighted instants
+///
+/// ```text
+/// M a_{n+1−α_m} + f_int(u_{n+1−α_f}) = f_ext(t_{n+1−α_f}),   x_{n+1−α} = (1 − α) x_{n+1} + α x_n,
+/// α_m = (2ρ∞ − 1)/(ρ∞ + 1),  α_f = ρ∞/(ρ∞ + 1),  γ = ½ − α_m + α_f,  β = ¼ (1 − α_m + α_f)²,
+/// ```
+///
+/// with the Newmark relations (N1)–(N2) for u, v, a: second order, unconditionally stable,
+/// and the high-frequency modes damped to the spectral radius ρ∞ (ρ∞ = 1 has no dissipation).
+/// The internal force at the weighted instant is taken as the weighted force,
+/// f_int(u_{n+1−α_f}) ≈ (1 − α_f) f_int(u_{n+1}) + α_f f_int(u_n) (the form of Kuhl & Crisfield,
+/// *Int. J. Numer. Meth. Engng* 45 (1999) 569, §3.2, which keeps the updated-Lagrangian
+/// configuration of each step; the two agree for a linear f_int). Divided by 1 − α_f, a step
+/// solves
+///
+/// ```text
+/// f_int(u₁) + c_m M a₁ + c_a M a₀ + c_f (f_int(u₀) − f_ext(t₀)) = f_ext(t₁),
+/// c_m = (1 − α_m)/(1 − α_f),  c_a = α_m/(1 − α_f),  c_f = α_f/(1 − α_f),
+/// ```
+///
+/// with f_int(u₀) the committed stresses' force on the step's own grid or mesh, and the
+/// effective tangent K + c_m M/(βΔt²).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GeneralizedAlpha {
+    pub alpha_m: f64,
+    pub alpha_f: f64,
+    pub beta: f64,
+    pub gamma: f64,
+}
+
+impl GeneralizedAlpha {
+    /// The parameters of spectral radius ρ∞ (Chung & Hulbert 1993, eq 25).
+    pub fn of_spectral_radius(rho: f64) -> Self {
+        let alpha_m = (2.0 * rho - 1.0) / (rho + 1.0);
+        let alpha_f = rho / (rho + 1.0);
+        GeneralizedAlpha {
+            alpha_m,
+            alpha_f,
+            beta: 0.25 * (1.0 - alpha_m + alpha_f).powi(2),
+            gamma: 0.5 - alpha_m + alpha_f,
+        }
+    }
 }
 
 fn quarter() -> f64 {
@@ -106,6 +157,29 @@ impl Newmark {
             gamma: half(),
             mass: MassMatrix::Consistent,
             load: LoadHistory::Sudden,
+            rho_infinity: None,
+        }
+    }
+
+    /// Generalised-α of spectral radius `rho` ([`GeneralizedAlpha`]), consistent mass, sudden
+    /// load, over `duration`.
+    pub fn generalized_alpha(duration: f64, rho: f64) -> Self {
+        Newmark {
+            rho_infinity: Some(rho),
+            ..Self::trapezoidal(duration)
+        }
+    }
+
+    /// β, γ, α_m, α_f of the scheme: Newmark's with α_m = α_f = 0, or generalised-α's.
+    pub fn parameters(&self) -> GeneralizedAlpha {
+        match self.rho_infinity {
+            Some(rho) => GeneralizedAlpha::of_spectral_radius(rho),
+            None => GeneralizedAlpha {
+                alpha_m: 0.0,
+                alpha_f: 0.0,
+                beta: self.beta,
+                gamma: self.gamma,
+            },
         }
     }
 
@@ -125,15 +199,34 @@ impl Newmark {
                 "must lie in [0.5, 1]",
             ));
         }
+        if let Some(rho) = self.rho_infinity {
+            if !(0.0..=1.0).contains(&rho) {
+                return Err(InputError::new(
+                    "dynamics.rho_infinity",
+                    rho,
+                    "must lie in [0, 1] (the spectral radius of generalised-α at high frequency)",
+                ));
+            }
+            if self.beta != quarter() || self.gamma != half() {
+                return Err(InputError::new(
+                    "dynamics.beta",
+                    format!("beta = {}, gamma = {}", self.beta, self.gamma),
+                    "must be left at 0.25, 0.5 with rho_infinity: generalised-α derives both from it",
+                ));
+            }
+        }
         Ok(())
     }
 
     /// The coefficients of one step of length `dt`.
     pub fn step(&self, dt: f64) -> NewmarkStep {
+        let p = self.parameters();
         NewmarkStep {
             dt,
-            beta: self.beta,
-            gamma: self.gamma,
+            beta: p.beta,
+            gamma: p.gamma,
+            alpha_m: p.alpha_m,
+            alpha_f: p.alpha_f,
         }
     }
 
@@ -160,15 +253,57 @@ pub struct TimeStep {
     pub load_factor: f64,
 }
 
-/// (N1)–(N2) for one step of length `dt`.
+/// (N1)–(N2) for one step of length `dt`, and the weights α_m, α_f of generalised-α (zero for
+/// Newmark).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewmarkStep {
     pub dt: f64,
     pub beta: f64,
     pub gamma: f64,
+    pub alpha_m: f64,
+    pub alpha_f: f64,
 }
 
 impl NewmarkStep {
+    /// Plain Newmark: the step balances the equation of motion at its end.
+    pub fn is_newmark(&self) -> bool {
+        self.alpha_m == 0.0 && self.alpha_f == 0.0
+    }
+
+    /// c_f = α_f / (1 − α_f): the weight of f_int(u₀) − f_ext(t₀) in a step ([`GeneralizedAlpha`]).
+    pub fn start_force_weight(&self) -> f64 {
+        self.alpha_f / (1.0 - self.alpha_f)
+    }
+
+    /// The acceleration the inertia force of a step is M times: a₁ (N1) for Newmark, c_m a₁ +
+    /// c_a a₀ for generalised-α ([`GeneralizedAlpha`]), a₁ = Δu/(βΔt²) − ã.
+    pub fn inertia_acceleration(&self, du: f64, predictor: f64, a0: f64) -> f64 {
+        if self.is_newmark() {
+            return self.acceleration_after(du, predictor);
+        }
+        let den = 1.0 - self.alpha_f;
+        (1.0 - self.alpha_m) / den * self.acceleration_after(du, predictor) + self.alpha_m / den * a0
+    }
+
+    /// The part of [`Self::inertia_acceleration`] that does not depend on Δu, negated: ã for
+    /// Newmark, c_m ã − c_a a₀ for generalised-α.
+    pub fn inertia_predictor(&self, predictor: f64, a0: f64) -> f64 {
+        if self.is_newmark() {
+            return predictor;
+        }
+        let den = 1.0 - self.alpha_f;
+        (1.0 - self.alpha_m) / den * predictor - self.alpha_m / den * a0
+    }
+
+    /// ∂(inertia acceleration)/∂Δu, the factor of M in the effective tangent: 1/(βΔt²) for
+    /// Newmark, c_m/(βΔt²) for generalised-α.
+    pub fn tangent_mass_factor(&self) -> f64 {
+        if self.is_newmark() {
+            return self.mass_factor();
+        }
+        (1.0 - self.alpha_m) / (1.0 - self.alpha_f) * self.mass_factor()
+    }
+
     /// 1 / (β Δt²): ∂a₁/∂Δu, the factor of M in the effective tangent.
     pub fn mass_factor(&self) -> f64 {
         1.0 / (self.beta * self.dt * self.dt)
@@ -292,6 +427,73 @@ mod tests {
         assert!((rate - 2.0).abs() < 0.05, "rate {rate} ({e1:e}, {e2:e})");
     }
 
+    /// One generalised-α step of m ü + k u = f as the solvers take it (the residual of
+    /// [`GeneralizedAlpha`] with [`NewmarkStep::inertia_acceleration`]), linear so solved at
+    /// once, with the weight `c_f` of the start-force term given (the scheme's
+    /// [`NewmarkStep::start_force_weight`]; 0: a wrong variant); returns the new (u, v, a).
+    fn alpha_step(
+        n: &NewmarkStep,
+        c_f: f64,
+        (k, m): (f64, f64),
+        (u, v, a): (f64, f64, f64),
+        (f0, f1): (f64, f64),
+    ) -> (f64, f64, f64) {
+        let pred = n.predictor(v, a);
+        // k (u + Δu) + m (c_m/(βΔt²) Δu − inertia predictor) + c_f (k u − f₀) = f₁.
+        let rhs = f1 - k * u - c_f * (k * u - f0) + m * n.inertia_predictor(pred, a);
+        let du = rhs / (k + m * n.tangent_mass_factor());
+        let a1 = n.acceleration(du, v, a);
+        (u + du, v + n.velocity_change(a, a1), a1)
+    }
+
+    /// Generalised-α through the solvers' coefficients: at ωΔt = 10⁴ the state decays per step
+    /// by the spectral radius ρ∞ (Chung & Hulbert 1993, eq 25's design), and at small ωΔt the
+    /// scheme is second order; ρ∞ = 1 has no dissipation.
+    #[test]
+    fn generalized_alpha_damps_by_its_spectral_radius_and_is_second_order() {
+        let k = 1e8; // ωΔt = 10⁴
+                     // The amplification matrix of (u, v, a), column by column, and its spectral radius (a
+                     // double root −ρ∞ at infinity, so the decay of a run converges slowly to it).
+        let radius_of = |n: &NewmarkStep, c_f: f64| {
+            let columns = [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
+                .map(|s| alpha_step(n, c_f, (k, 1.0), s, (0.0, 0.0)));
+            let amp = nalgebra::Matrix3::from_fn(|i, j| {
+                let c = columns[j];
+                [c.0, c.1, c.2][i]
+            });
+            amp.complex_eigenvalues()
+                .iter()
+                .map(|l| l.norm())
+                .fold(0.0, f64::max)
+        };
+        for rho in [0.0, 0.5, 0.8, 1.0] {
+            let n = Newmark::generalized_alpha(1.0, rho).step(1.0);
+            let radius = radius_of(&n, n.start_force_weight());
+            // Measured offsets 1.7e-3 (ρ∞ = 0.5, 0.8) and 2.2e-3 (ρ∞ = 0): a finite ωΔt and
+            // the double root, whose eigenvalues are sensitive to round-off.
+            assert!(
+                (radius - rho).abs() < 5e-3,
+                "ρ∞ = {rho}: spectral radius {radius}"
+            );
+        }
+        let omega = 2.0 * std::f64::consts::PI;
+        // `with_start`: the term c_f (f_int(u₀) − f_ext(t₀)) kept, or dropped (a wrong variant).
+        let error = |steps: usize, with_start: bool| {
+            let n = Newmark::generalized_alpha(1.0, 0.8).step(1.0 / steps as f64);
+            let c_f = if with_start { n.start_force_weight() } else { 0.0 };
+            let mut s = (0.0, omega, 0.0);
+            for _ in 0..steps {
+                s = alpha_step(&n, c_f, (omega * omega, 1.0), s, (0.0, 0.0));
+            }
+            s.0.abs()
+        };
+        let rate = (error(64, true) / error(128, true)).log2();
+        assert!((rate - 2.0).abs() < 0.05, "rate {rate}");
+        let wrong = (error(64, false) / error(128, false)).log2();
+        println!("rate {rate}, without the start force {wrong}");
+        assert!((wrong - 2.0).abs() > 0.5, "the wrong variant's rate {wrong}");
+    }
+
     #[test]
     fn bad_coefficients_name_their_key() {
         let mut n = Newmark::trapezoidal(1.0);
@@ -301,6 +503,18 @@ mod tests {
         n.gamma = 0.4;
         assert!(n.validate().unwrap_err().to_string().contains("dynamics.gamma"));
         n.gamma = 0.5;
+        n.rho_infinity = Some(1.5);
+        assert!(n
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("dynamics.rho_infinity"));
+        n.rho_infinity = Some(0.8);
+        n.beta = 0.3;
+        assert!(n.validate().unwrap_err().to_string().contains("dynamics.beta"));
+        n.beta = 0.25;
+        n.validate().unwrap();
+        n.rho_infinity = None;
         n.duration = 0.0;
         assert!(n
             .validate()

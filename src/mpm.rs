@@ -1,6 +1,6 @@
 //! The implicit material point solver: load-step loop, Newton solve and commit (Figures 6–7).
 
-use crate::assembly::{StepInput, StepWorkspace, SupportTable};
+use crate::assembly::{StartForces, StepInput, StepWorkspace, SupportTable};
 use crate::basis::{Basis, BasisError, BasisFamily, PointSupport};
 use crate::constitutive::ConstitutiveModel;
 use crate::dynamics::{BodyForce, Inertia, Newmark, NewmarkStep, TimeStep};
@@ -558,6 +558,10 @@ macro_rules! step_input {
                 mass: $solver.settings.dynamics.map(|d| d.mass).unwrap_or_default(),
                 point_masses: &$solver.points.mass,
             }),
+            start_forces: $step.start_forces.as_deref().map(|f| StartForces {
+                point_forces: f,
+                nodal_forces: &[],
+            }),
         }
     };
 }
@@ -571,6 +575,8 @@ struct PreparedStep<const D: usize> {
     weak_nodes: usize,
     /// The time step of a dynamic analysis.
     time_step: Option<TimeStep>,
+    /// Generalised-α: the point forces at the step's start.
+    start_forces: Option<Vec<SVector<f64, D>>>,
 }
 
 impl<const D: usize> MpmSolver<D> {
@@ -586,6 +592,16 @@ impl<const D: usize> MpmSolver<D> {
             let t = time_step.map_or(load_factor, |t| t.end);
             b.add_to(&self.points.position0, &self.points.volume0, t, &mut forces)?;
         }
+        let start_forces = match (self.settings.dynamics, &time_step) {
+            (Some(d), Some(t)) if !t.newmark.is_newmark() => {
+                let mut f = self.external_point_forces(d.load.factor(self.time));
+                if let Some(b) = &self.body_force {
+                    b.add_to(&self.points.position0, &self.points.volume0, self.time, &mut f)?;
+                }
+                Some(f)
+            }
+            _ => None,
+        };
         let (weak, ties) = self.weak_nodes();
         let mut fixed = self.fixed.clone();
         let tied: Vec<usize> = ties.iter().map(|t| t.0).collect();
@@ -603,6 +619,7 @@ impl<const D: usize> MpmSolver<D> {
             ties,
             weak_nodes: weak.len(),
             time_step,
+            start_forces,
         })
     }
 

@@ -4,7 +4,7 @@
 //! positions). A solver adds only its shape functions: it fills the [`SupportTable`] with
 //! N_a(ξ_q) and ∂N_a/∂X̃ on the start-of-step mesh and moves its nodes by the increment.
 
-use crate::assembly::{LoadStepSystem, StepInput, StepWorkspace, SupportTable};
+use crate::assembly::{LoadStepSystem, StartForces, StepInput, StepWorkspace, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::dynamics::{BodyForce, Inertia, Newmark, TimeStep};
 use crate::error::{require_count, InputError, StepFailure};
@@ -213,6 +213,24 @@ impl<const D: usize> UlCore<D> {
             .iter()
             .map(|&(dof, force)| (dof, force * load_factor))
             .collect();
+        // Generalised-α: the same loads at the step's start t₀.
+        let start = match (self.dynamics, self.motion.pending) {
+            (Some(d), Some(t)) if !t.newmark.is_newmark() => {
+                let (t0, f0) = (self.motion.time, d.load.factor(self.motion.time));
+                let mut forces: Vec<SVector<f64, D>> =
+                    loads.mass.iter().map(|&m| loads.gravity * (m * f0)).collect();
+                if let Some((b, x0, v0)) = &self.body_force {
+                    b.add_to(x0, v0, t0, &mut forces)?;
+                }
+                let nodal: Vec<(usize, f64)> = loads
+                    .dof_forces
+                    .iter()
+                    .map(|&(dof, force)| (dof, force * f0))
+                    .collect();
+                Some((forces, nodal))
+            }
+            _ => None,
+        };
         let input = StepInput {
             model: self.model.as_ref(),
             states,
@@ -228,6 +246,10 @@ impl<const D: usize> UlCore<D> {
                 acceleration: &self.motion.acceleration,
                 mass: self.dynamics.map(|d| d.mass).unwrap_or_default(),
                 point_masses: loads.mass,
+            }),
+            start_forces: start.as_ref().map(|(f, n)| StartForces {
+                point_forces: f,
+                nodal_forces: n,
             }),
         };
         Ok(f(&mut self.work, &input))

@@ -223,11 +223,23 @@ impl CantileverSpec {
 
     /// [`Self::mpm_solver`] with the basis family `basis`.
     pub fn mpm_solver_with(&self, basis: Basis) -> Result<(MpmSolver<2>, [usize; 2]), InputError> {
+        self.mpm_solver_2d(basis, 1.0, None)
+    }
+
+    /// The plane-strain solver of density `density` (a quasi-static analysis has no use for
+    /// it), Newmark time stepping if `dynamics` is given (its steps replace `load_steps`).
+    pub fn mpm_solver_2d(
+        &self,
+        basis: Basis,
+        density: f64,
+        dynamics: Option<crate::dynamics::Newmark>,
+    ) -> Result<(MpmSolver<2>, [usize; 2]), InputError> {
         self.validate()?;
         let h = self.element_size;
         let grid = self.grid_2d()?;
         let ppc = self.points_per_cell;
-        let points = MaterialPoints::fill_box(&grid, [0.0, 0.0], [self.length, self.depth], [ppc, ppc], 1.0)?;
+        let points =
+            MaterialPoints::fill_box(&grid, [0.0, 0.0], [self.length, self.depth], [ppc, ppc], density)?;
         let axis_y = 0.5 * self.depth;
         let mut fixed: Vec<(usize, usize)> =
             grid.nodes_on_plane(0, 0.0).into_iter().map(|n| (n, 0)).collect();
@@ -245,8 +257,12 @@ impl CantileverSpec {
             point_loads: vec![(loaded[0], force), (loaded[1], force)],
         };
         let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
+        let settings = MpmSettings {
+            dynamics,
+            ..self.mpm_settings(basis)
+        };
         Ok((
-            MpmSolver::try_new(grid, points, model, fixed, loads, self.mpm_settings(basis))?,
+            MpmSolver::try_new(grid, points, model, fixed, loads, settings)?,
             loaded,
         ))
     }
@@ -501,6 +517,12 @@ pub struct FemOutcome {
 /// and the end load as a dead nodal force on the neutral-axis end node, as in the paper
 /// (Figure 21). The end displacement is that node's.
 pub fn solve_fem_q8(spec: &CantileverSpec) -> Result<FemOutcome, InputError> {
+    let (fem, tip) = fem_q8(spec, 1.0)?;
+    Ok(run_fem(spec, fem, tip))
+}
+
+/// The Q8 beam of [`solve_fem_q8`] at density `density`, and its tip node (L, d/2).
+pub fn fem_q8(spec: &CantileverSpec, density: f64) -> Result<(PlaneFem, usize), InputError> {
     spec.validate()?;
     let h = spec.element_size;
     let cells = (
@@ -526,8 +548,8 @@ pub fn solve_fem_q8(spec: &CantileverSpec) -> Result<FemOutcome, InputError> {
         nodal_forces: vec![(tip, SVector::<f64, 2>::new(0.0, -spec.load))],
     };
     let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
-    let fem = PlaneFem::try_new(mesh, 1.0, model, fixed, loads, fem_settings(spec, Some(3)))?;
-    Ok(run_fem(spec, fem, tip))
+    let fem = PlaneFem::try_new(mesh, density, model, fixed, loads, fem_settings(spec, Some(3)))?;
+    Ok((fem, tip))
 }
 
 /// Updated-Lagrangian Hex8 (2×2×2 Gauss points) or Hex20 (3×3×3) FEM of the 3D beam on the

@@ -71,6 +71,11 @@ pub struct DynamicManufacturedSpec {
     pub gamma: f64,
     pub mass: MassMatrix,
     pub newton: NewtonSettings,
+    /// Generalised-α's spectral radius ρ∞ instead of `beta`, `gamma`
+    /// ([`crate::dynamics::GeneralizedAlpha`]); not serialised when absent (Newmark cases keep
+    /// their keys).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho_infinity: Option<f64>,
     pub domain_update: DomainUpdate,
     /// 2 (the unit square, plane strain) or 3 (the unit cube). Not serialised at 2.
     #[serde(default = "plane", skip_serializing_if = "is_plane")]
@@ -105,6 +110,7 @@ impl Default for DynamicManufacturedSpec {
             gamma: 0.5,
             mass: MassMatrix::Consistent,
             newton: NewtonSettings::default(),
+            rho_infinity: None,
             domain_update: DomainUpdate::Stretch,
             dimension: 2,
         }
@@ -201,6 +207,7 @@ impl DynamicManufacturedSpec {
             gamma: self.gamma,
             mass: self.mass,
             load: LoadHistory::None,
+            rho_infinity: self.rho_infinity,
         }
     }
 }

@@ -3,6 +3,7 @@
 
 pub mod bar;
 pub mod cantilever;
+pub mod cantilever_dynamic;
 pub mod column;
 pub mod compaction;
 pub mod elastica;

@@ -102,6 +102,7 @@ fn case_field(measure: &str) -> &str {
         "displacement" => "displacement_error",
         "stress" => "stress_error",
         "period" => "period_error",
+        "tip" => "tip_error",
         m => m,
     }
 }

@@ -99,3 +99,41 @@ fn damped_newmark_fails_the_time_rate_band() {
         c.measured
     );
 }
+
+/// The large-amplitude bar (`studies/vibrating-bar-large.toml`), quick tier: its five checks
+/// (iGIMP, CPDI2 and Line2 second order in h against the Line3 reference, iGIMP and Line3
+/// second order in Δt) are evaluated and pass, and every case was measured against its
+/// reference.
+#[test]
+fn every_large_amplitude_bar_check_passes() {
+    let s =
+        DynamicStudy::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/vibrating-bar-large.toml"))
+            .expect("studies/vibrating-bar-large.toml parses");
+    let r = run_in_memory(&s, "vibrating-bar-large.toml", Tier::Quick)
+        .expect("an in-memory run")
+        .results;
+    assert_eq!(
+        r.checks.len(),
+        5,
+        "{:?}",
+        r.checks.iter().map(|c| &c.id).collect::<Vec<_>>()
+    );
+    for c in &r.checks {
+        assert_eq!(
+            c.pass,
+            Some(true),
+            "{}: {} ({:?})",
+            c.id,
+            c.description,
+            c.measured
+        );
+    }
+    for c in &r.cases {
+        assert!(
+            c.displacement_error.is_some() && c.reference_failure.is_none(),
+            "{}",
+            c.id
+        );
+        assert!(c.id.contains("-vs-fem-quadratic-e256-"), "{}", c.id);
+    }
+}

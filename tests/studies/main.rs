@@ -2,6 +2,7 @@
 //! for byte, resume, ParaView output and thread-count independence. One test binary.
 
 mod bar_study;
+mod cantilever_dynamic_study;
 mod cantilever_study;
 mod column3d_study;
 mod compaction_reference_study;

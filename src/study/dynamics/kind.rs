@@ -6,17 +6,21 @@
 //! figure draws goes to `histories.json`.
 
 use super::records::{DynamicMeasures, DynamicRecord, DynamicResults, ExpectedBand, RateRecord, Series};
-use super::CaseSpec;
+use super::{BarCase, BarReferenceRun, CantileverCase, CaseSpec, ReferenceRun};
 use super::{DynamicCase, DynamicMeasure, DynamicStudy, FigureKind, Refinement};
 use crate::load_stepping::StepReport;
 use crate::problems::bar::{self, BarSpec};
+use crate::problems::cantilever_dynamic::{self, DynamicCantileverOutcome};
 use crate::problems::manufactured_dynamic::{self, DynamicManufacturedSpec};
 use crate::study::checks::{check_at_most, check_rate, CheckRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{write_case_data, SolveRecord, SweepIndex};
 use crate::study::{StudyError, Tier};
+use std::any::Any;
 use std::collections::BTreeSet;
+use std::collections::HashMap;
 use std::path::Path;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// (t, u of the free end) after every step.
 pub type History = Vec<[f64; 2]>;
@@ -25,7 +29,119 @@ fn solve_case(case: &DynamicCase) -> (DynamicRecord, History) {
     match &case.spec {
         CaseSpec::Bar(spec) => solve_bar(case, spec),
         CaseSpec::Manufactured(spec) => (solve_manufactured(case, spec), vec![]),
+        CaseSpec::Cantilever(c) => solve_cantilever(case, c),
+        CaseSpec::BarAgainst(c) => solve_bar_against(case, c),
     }
+}
+
+/// The value of `key`, computed once per process by the first caller (the others, on any
+/// thread, wait for it): each reference analysis is solved once however many cases ask.
+fn cached<T: Send + Sync + 'static>(key: String, solve: impl FnOnce() -> T) -> Arc<T> {
+    type Slot = Arc<dyn Any + Send + Sync>;
+    static CACHE: OnceLock<Mutex<HashMap<String, Slot>>> = OnceLock::new();
+    let slot = CACHE
+        .get_or_init(Default::default)
+        .lock()
+        .expect("reference cache")
+        .entry(key)
+        .or_insert_with(|| Arc::new(OnceLock::<Arc<T>>::new()))
+        .clone();
+    let cell = slot
+        .downcast_ref::<OnceLock<Arc<T>>>()
+        .expect("one value type per key (keys name their problem)");
+    cell.get_or_init(|| Arc::new(solve())).clone()
+}
+
+/// A reference analysis' outcome, or why it has none (rejected, or failed at a step).
+fn reference_result<O>(
+    method: crate::method::Method,
+    solved: Result<O, crate::error::InputError>,
+    failure: impl Fn(&O) -> Option<(usize, String)>,
+) -> Result<O, String> {
+    let o = solved.map_err(|e| format!("reference {} rejected: {e}", method.name()))?;
+    match failure(&o) {
+        Some((step, why)) => Err(format!(
+            "reference {} failed at step {step}: {why}",
+            method.name()
+        )),
+        None => Ok(o),
+    }
+}
+
+/// The cantilever reference of `run` (solved once per process).
+fn cantilever_reference(run: &ReferenceRun) -> Arc<Result<DynamicCantileverOutcome, String>> {
+    let key = format!(
+        "cantilever:{}",
+        serde_json::to_string(run).expect("a reference run serialises")
+    );
+    cached(key, || {
+        reference_result(
+            run.method,
+            cantilever_dynamic::solve(&run.spec, run.method),
+            |o| o.failure.as_ref().map(|f| (o.steps.len() + 1, f.to_string())),
+        )
+    })
+}
+
+/// The bar reference of `run` (solved once per process).
+fn bar_reference(run: &BarReferenceRun) -> Arc<Result<bar::BarOutcome, String>> {
+    let key = format!(
+        "bar:{}",
+        serde_json::to_string(run).expect("a reference run serialises")
+    );
+    cached(key, || {
+        reference_result(run.method, bar::solve(&run.spec, run.method), |o| {
+            o.failure.as_ref().map(|f| (o.steps.len() + 1, f.to_string()))
+        })
+    })
+}
+
+/// A bar measured against its reference: the end field and the period of the reference
+/// instead of the closed form's; the energy is the case's own.
+fn solve_bar_against(case: &DynamicCase, c: &BarCase) -> (DynamicRecord, History) {
+    let o = match bar::solve(&c.spec, case.method) {
+        Err(e) => return (base_record(case, SolveRecord::rejected(e), None, 0), vec![]),
+        Ok(o) => o,
+    };
+    let (mut rec, history) = bar_record(case, &c.spec, &o);
+    let reference = bar_reference(&c.reference);
+    let against = Some(&o)
+        .filter(|o| o.failure.is_none())
+        .zip(reference.as_ref().as_ref().ok());
+    rec.displacement_error = against
+        .and_then(|(o, r)| o.displacement_error_against(&c.spec, r))
+        .and_then(finite);
+    rec.period_error = against
+        .and_then(|(o, r)| o.measured_period.zip(r.measured_period))
+        .map(|(t, tr)| (t - tr).abs() / tr);
+    rec.reference_failure = reference.as_ref().as_ref().err().cloned();
+    (rec, history)
+}
+
+fn solve_cantilever(case: &DynamicCase, c: &CantileverCase) -> (DynamicRecord, History) {
+    let o = match cantilever_dynamic::solve(&c.spec, case.method) {
+        Err(e) => return (base_record(case, SolveRecord::rejected(e), None, 0), vec![]),
+        Ok(o) => o,
+    };
+    let solve = SolveRecord::of(&o.steps, o.failure.as_ref());
+    let reference = cantilever_reference(&c.reference);
+    let converged = Some(&o).filter(|o| o.failure.is_none());
+    let against = converged.zip(reference.as_ref().as_ref().ok());
+    let period = converged.and_then(|o| o.period());
+    let rec = DynamicRecord {
+        tip_error: against.and_then(|(o, r)| o.tip_error(r)).and_then(finite),
+        peak_deflection: converged.map(|o| o.peak()),
+        measured_period: period,
+        period_error: against
+            .and_then(|(_, r)| r.period())
+            .zip(period)
+            .map(|(tr, t)| (t - tr).abs() / tr),
+        energy_drift: converged.and_then(|o| finite(o.energy_drift())),
+        // A converged case that cannot be measured says why beside its status.
+        reference_failure: reference.as_ref().as_ref().err().cloned(),
+        ..base_record(case, solve, Some(&o.steps), o.points)
+    };
+    (rec, o.tip.iter().map(|&(t, v)| [t, v]).collect())
 }
 
 /// The record of a case from its solve (status, failure, the last step's history) and the
@@ -68,6 +184,9 @@ fn base_record(
         measured_period: None,
         period_error: None,
         energy_drift: None,
+        tip_error: None,
+        peak_deflection: None,
+        reference_failure: None,
         points,
     }
 }
@@ -77,17 +196,21 @@ fn finite(x: f64) -> Option<f64> {
 }
 
 fn solve_bar(case: &DynamicCase, spec: &BarSpec) -> (DynamicRecord, History) {
-    let o = match bar::solve(spec, case.method) {
-        Err(e) => return (base_record(case, SolveRecord::rejected(e), None, 0), vec![]),
-        Ok(o) => o,
-    };
+    match bar::solve(spec, case.method) {
+        Err(e) => (base_record(case, SolveRecord::rejected(e), None, 0), vec![]),
+        Ok(o) => bar_record(case, spec, &o),
+    }
+}
+
+/// The record of a bar analysis against the closed form, and its free-end history.
+fn bar_record(case: &DynamicCase, spec: &BarSpec, o: &bar::BarOutcome) -> (DynamicRecord, History) {
     let base = base_record(
         case,
         SolveRecord::of(&o.steps, o.failure.as_ref()),
         Some(&o.steps),
         o.points.len(),
     );
-    let conv = Some(&o).filter(|o| o.failure.is_none());
+    let conv = Some(o).filter(|o| o.failure.is_none());
     let (exact, end) = (spec.period(), spec.duration());
     let rec = DynamicRecord {
         displacement_error: conv.and_then(|o| finite(o.displacement_error(spec, end))),
@@ -153,11 +276,14 @@ impl StudyKind for DynamicStudy {
     }
     fn measure(results: &mut Results<Self>) {
         let study = &results.study;
-        results.measures.exact_period = study
-            .sweeps
-            .iter()
-            .find_map(|s| study.case_spec(s, Default::default(), 1, 1, 1))
-            .map_or(f64::NAN, |c| c.period());
+        results.measures.exact_period = match &study.cantilever {
+            Some(c) => DynamicStudy::cantilever_spec(c, &study.newton, Default::default(), 2, 1, 1).period(),
+            None => study
+                .sweeps
+                .iter()
+                .find_map(|s| study.case_spec(s, Default::default(), 1, 1, 1))
+                .map_or(f64::NAN, |c| c.period()),
+        };
         results.measures.rates = rates(results);
         results.checks = checks(results);
     }
@@ -215,6 +341,8 @@ fn rates(results: &DynamicResults) -> Vec<RateRecord> {
         for s in results.sweep_series(&sw.id) {
             let measures = if study.bar.is_some() {
                 [DynamicMeasure::Displacement, DynamicMeasure::Period]
+            } else if study.cantilever.is_some() {
+                [DynamicMeasure::Tip, DynamicMeasure::Period]
             } else {
                 [DynamicMeasure::Displacement, DynamicMeasure::Stress]
             };

@@ -15,6 +15,8 @@ use super::{StudyError, Tier};
 use crate::dynamics::MassMatrix;
 use crate::method::Method;
 use crate::problems::bar::BarSpec;
+use crate::problems::cantilever::CantileverSpec;
+use crate::problems::cantilever_dynamic::DynamicCantileverSpec;
 use crate::problems::manufactured::Field;
 use crate::problems::manufactured_dynamic::{self, DynamicManufacturedSpec};
 use crate::study::engine::distinct_cases;
@@ -38,6 +40,9 @@ pub struct BarSection {
     pub beta: f64,
     #[serde(default = "half")]
     pub gamma: f64,
+    /// Generalised-α's ρ∞ instead of Newmark's β, γ.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho_infinity: Option<f64>,
 }
 
 /// The dynamic manufactured fields of every case
@@ -57,9 +62,50 @@ pub struct ManufacturedSection {
     pub beta: f64,
     #[serde(default = "half")]
     pub gamma: f64,
+    /// Generalised-α's ρ∞ instead of Newmark's β, γ.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho_infinity: Option<f64>,
     /// 2 (the unit square, plane strain) or 3 (the unit cube).
     #[serde(default = "plane", skip_serializing_if = "is_plane")]
     pub dimension: usize,
+}
+
+/// The dynamic cantilever of every case ([`crate::problems::cantilever_dynamic`]): the paper's
+/// beam, its end load applied suddenly and held.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CantileverSection {
+    pub length: f64,
+    pub depth: f64,
+    pub young_modulus: f64,
+    pub poisson_ratio: f64,
+    /// P (N), downwards.
+    pub load: f64,
+    pub density: f64,
+    /// Grid room below the beam and beyond its end and top (material point methods).
+    pub grid_below: f64,
+    pub grid_margin: f64,
+    /// Simulated time in units of the Euler–Bernoulli first-mode period T₁.
+    pub periods: f64,
+    #[serde(default = "quarter")]
+    pub beta: f64,
+    #[serde(default = "half")]
+    pub gamma: f64,
+    /// Generalised-α's ρ∞ instead of Newmark's β, γ.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rho_infinity: Option<f64>,
+}
+
+/// The analysis a sweep's cases are measured against (the dynamic cantilever, which has no
+/// closed form): `method` (absent: each case's own, a temporal or spatial self-convergence) on
+/// `elements` with `steps_per_period`, otherwise as the case.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepReference {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method: Option<Method>,
+    pub elements: i64,
+    pub steps_per_period: i64,
 }
 
 fn plane() -> usize {
@@ -90,6 +136,8 @@ pub struct SweepQuick {
     pub elements: Option<Vec<i64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub steps_per_period: Option<Vec<i64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<SweepReference>,
 }
 
 /// One sweep: the lists' product, one of `elements` and `steps_per_period` varied.
@@ -107,6 +155,9 @@ pub struct DynamicSweep {
     pub elements: Vec<i64>,
     pub points_per_cell: Vec<i64>,
     pub steps_per_period: Vec<i64>,
+    /// What the cases are measured against (the cantilever; required there, absent elsewhere).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<SweepReference>,
     #[serde(default)]
     pub quick: SweepQuick,
 }
@@ -144,16 +195,20 @@ pub enum DynamicMeasure {
     Stress,
     /// |T_h − T| / T, T_h from the free end's zero crossings.
     Period,
-    /// max_t |E(t) − E(0)| / E(0).
+    /// max_t |E(t) − E(0)| / E(0) (the cantilever: max_t |K + U − W| / max_t W).
     Energy,
+    /// max_n |v(t_n) − v_ref(t_n)| / max_t |v_ref|: the tip deflection history against the
+    /// sweep's reference (the cantilever).
+    Tip,
 }
 
 impl DynamicMeasure {
-    pub const ALL: [DynamicMeasure; 4] = [
+    pub const ALL: [DynamicMeasure; 5] = [
         DynamicMeasure::Displacement,
         DynamicMeasure::Stress,
         DynamicMeasure::Period,
         DynamicMeasure::Energy,
+        DynamicMeasure::Tip,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -161,6 +216,7 @@ impl DynamicMeasure {
             DynamicMeasure::Stress => "stress",
             DynamicMeasure::Period => "period",
             DynamicMeasure::Energy => "energy",
+            DynamicMeasure::Tip => "tip",
         }
     }
     pub fn label(self) -> &'static str {
@@ -169,6 +225,7 @@ impl DynamicMeasure {
             DynamicMeasure::Stress => "stress error at the end, form of eq (46)",
             DynamicMeasure::Period => "relative period error",
             DynamicMeasure::Energy => "largest relative energy change",
+            DynamicMeasure::Tip => "tip deflection history error against the reference",
         }
     }
 }
@@ -249,6 +306,8 @@ pub struct DynamicStudy {
     pub bar: Option<BarSection>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub manufactured: Option<ManufacturedSection>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cantilever: Option<CantileverSection>,
     pub newton: NewtonSection,
     pub sweeps: Vec<DynamicSweep>,
     #[serde(default)]
@@ -271,9 +330,48 @@ pub struct DynamicCase {
 /// its spec) is what it was before the kind had a second problem.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(untagged)]
+// A study holds tens of cases: the cantilever's size (its spec and its reference's) costs
+// nothing, and boxing it would lose Copy.
+#[allow(clippy::large_enum_variant)]
 pub enum CaseSpec {
     Bar(BarSpec),
     Manufactured(DynamicManufacturedSpec),
+    Cantilever(CantileverCase),
+    /// A bar measured against a reference analysis instead of the small-amplitude closed form.
+    BarAgainst(BarCase),
+}
+
+/// A vibrating bar case and the analysis it is measured against.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct BarCase {
+    pub spec: BarSpec,
+    pub reference: BarReferenceRun,
+}
+
+/// The reference analysis of a bar case.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct BarReferenceRun {
+    pub method: Method,
+    pub spec: BarSpec,
+}
+
+/// A dynamic cantilever case and the analysis it is measured against.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CantileverCase {
+    pub spec: DynamicCantileverSpec,
+    pub reference: ReferenceRun,
+}
+
+/// The reference analysis of a cantilever case.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ReferenceRun {
+    pub method: Method,
+    pub spec: DynamicCantileverSpec,
+}
+
+/// Elements through the depth of a cantilever spec (h = depth / elements).
+fn through_depth(s: &DynamicCantileverSpec) -> usize {
+    (s.beam.depth / s.beam.element_size).round() as usize
 }
 
 impl CaseSpec {
@@ -281,15 +379,24 @@ impl CaseSpec {
         match self {
             CaseSpec::Bar(b) => b.validate(),
             CaseSpec::Manufactured(m) => m.validate(),
+            CaseSpec::Cantilever(c) => c.spec.validate().and_then(|_| c.reference.spec.validate()),
+            CaseSpec::BarAgainst(c) => c.spec.validate().and_then(|_| c.reference.spec.validate()),
         }
     }
 
     /// Points (or Gauss points) × time steps: the planner's cost.
     pub fn cost(&self) -> f64 {
         match self {
-            CaseSpec::Bar(b) => (b.elements * b.points_per_cell * b.time_steps()) as f64,
+            CaseSpec::Bar(b) | CaseSpec::BarAgainst(BarCase { spec: b, .. }) => {
+                (b.elements * b.points_per_cell * b.time_steps()) as f64
+            }
             CaseSpec::Manufactured(m) => {
                 ((m.cells * m.points_per_cell).pow(m.dimension as u32) * m.time_steps()) as f64
+            }
+            CaseSpec::Cantilever(c) => {
+                let b = &c.spec.beam;
+                let cells = (b.length / b.element_size) * (b.depth / b.element_size);
+                cells * (b.points_per_cell * b.points_per_cell * c.spec.time_steps()) as f64
             }
         }
     }
@@ -298,7 +405,7 @@ impl CaseSpec {
     /// (cells per side), points per cell and time steps per period.
     pub fn levels(&self) -> CaseLevels {
         match self {
-            CaseSpec::Bar(b) => CaseLevels {
+            CaseSpec::Bar(b) | CaseSpec::BarAgainst(BarCase { spec: b, .. }) => CaseLevels {
                 field: None,
                 mass: b.mass,
                 elements: b.elements,
@@ -312,14 +419,23 @@ impl CaseSpec {
                 points_per_cell: m.points_per_cell,
                 steps_per_period: m.steps_per_period,
             },
+            CaseSpec::Cantilever(c) => CaseLevels {
+                field: None,
+                mass: c.spec.mass,
+                elements: through_depth(&c.spec),
+                points_per_cell: c.spec.beam.points_per_cell,
+                steps_per_period: c.spec.steps_per_period,
+            },
         }
     }
 
-    /// The period of the motion: the bar's 4L/c, the manufactured forcing's 2/c.
+    /// The period of the motion: the bar's 4L/c, the manufactured forcing's 2/c, the
+    /// cantilever's time unit T₁ (the Euler–Bernoulli first mode).
     pub fn period(&self) -> f64 {
         match self {
-            CaseSpec::Bar(b) => b.period(),
+            CaseSpec::Bar(b) | CaseSpec::BarAgainst(BarCase { spec: b, .. }) => b.period(),
             CaseSpec::Manufactured(m) => m.period(),
+            CaseSpec::Cantilever(c) => c.spec.period(),
         }
     }
 }
@@ -329,6 +445,7 @@ struct SweepPlan {
     methods: Vec<Method>,
     elements: Vec<i64>,
     steps_per_period: Vec<i64>,
+    reference: Option<SweepReference>,
 }
 
 /// The discretisation of one case ([`CaseSpec::levels`]).
@@ -357,6 +474,8 @@ pub const BAR_METHODS: [Method; 8] = [
 pub const MANUFACTURED_METHODS: [Method; 8] = manufactured_dynamic::METHODS;
 /// The methods of a 3D manufactured case: every material point family, Hex8 and Hex20.
 pub const MANUFACTURED_METHODS_3D: [Method; 8] = crate::problems::manufactured3d::METHODS_3D;
+/// The methods of a dynamic cantilever case: every material point family and Q8.
+pub const CANTILEVER_METHODS: [Method; 7] = crate::problems::cantilever_dynamic::METHODS;
 
 /// Most elements of one case (1D: cheap; a bound against typos).
 const MAX_ELEMENTS: i64 = 65_536;
@@ -379,6 +498,7 @@ impl DynamicSweep {
             steps_per_period: q
                 .and_then(|q| q.steps_per_period.clone())
                 .unwrap_or_else(|| self.steps_per_period.clone()),
+            reference: q.and_then(|q| q.reference).or(self.reference),
         })
     }
 
@@ -420,11 +540,86 @@ impl DynamicStudy {
             gamma: b.gamma,
             mass,
             newton: newton.settings(),
+            rho_infinity: b.rho_infinity,
         }
     }
 
+    /// The dynamic cantilever of one case: `elements` through the depth, `ppc` points per
+    /// cell along each axis, `steps` per T₁.
+    pub fn cantilever_spec(
+        c: &CantileverSection,
+        newton: &NewtonSection,
+        mass: MassMatrix,
+        elements: i64,
+        ppc: i64,
+        steps: i64,
+    ) -> DynamicCantileverSpec {
+        let beam = CantileverSpec {
+            length: c.length,
+            depth: c.depth,
+            young_modulus: c.young_modulus,
+            poisson_ratio: c.poisson_ratio,
+            load: c.load,
+            element_size: c.depth / elements as f64,
+            points_per_cell: ppc as usize,
+            grid_below: c.grid_below,
+            grid_margin: c.grid_margin,
+            newton: newton.settings(),
+            ..CantileverSpec::default()
+        };
+        DynamicCantileverSpec {
+            beam,
+            density: c.density,
+            periods: c.periods,
+            steps_per_period: steps as usize,
+            beta: c.beta,
+            gamma: c.gamma,
+            mass,
+            rho_infinity: c.rho_infinity,
+        }
+    }
+
+    /// The spec of one case of `sweep` by `method` (`None`: the file gives no problem section,
+    /// a manufactured sweep has no field or a cantilever sweep no reference; validation
+    /// reports each).
+    #[allow(clippy::too_many_arguments)]
+    fn case_spec_of(
+        &self,
+        sweep: &DynamicSweep,
+        method: Method,
+        reference: Option<&SweepReference>,
+        mass: MassMatrix,
+        elements: i64,
+        ppc: i64,
+        steps: i64,
+    ) -> Option<CaseSpec> {
+        if let Some(c) = &self.cantilever {
+            let r = reference?;
+            let spec = Self::cantilever_spec(c, &self.newton, mass, elements, ppc, steps);
+            return Some(CaseSpec::Cantilever(CantileverCase {
+                spec,
+                reference: ReferenceRun {
+                    method: r.method.unwrap_or(method),
+                    spec: Self::cantilever_spec(c, &self.newton, mass, r.elements, ppc, r.steps_per_period),
+                },
+            }));
+        }
+        let spec = self.case_spec(sweep, mass, elements, ppc, steps)?;
+        Some(match (spec, reference, &self.bar) {
+            (CaseSpec::Bar(spec), Some(r), Some(b)) => CaseSpec::BarAgainst(BarCase {
+                spec,
+                reference: BarReferenceRun {
+                    method: r.method.unwrap_or(method),
+                    spec: Self::bar_spec(b, &self.newton, mass, r.elements, ppc, r.steps_per_period),
+                },
+            }),
+            (spec, _, _) => spec,
+        })
+    }
+
     /// The spec of one case of `sweep` (`None`: the file gives neither problem section, or a
-    /// manufactured sweep without its field; validation reports both).
+    /// manufactured sweep without its field; validation reports both). Not for the cantilever,
+    /// whose cases also depend on their method and reference.
     pub fn case_spec(
         &self,
         sweep: &DynamicSweep,
@@ -464,6 +659,7 @@ impl DynamicStudy {
             newton: self.newton.settings(),
             domain_update: Default::default(),
             dimension: m.dimension,
+            rho_infinity: m.rho_infinity,
         }))
     }
 
@@ -481,11 +677,34 @@ impl DynamicStudy {
             MassMatrix::Lumped => "lm",
         };
         let field = field.map_or(String::new(), |f| format!("-{}", f.name()));
-        format!("{}{field}-{mass}-e{elements}-p{ppc}-n{steps}", method.name())
+        // A cantilever case names its reference: one discretisation may be measured against
+        // two (a space and a time sweep).
+        let reference = match spec {
+            CaseSpec::Cantilever(c) => format!(
+                "-vs-{}-e{}-n{}",
+                c.reference.method.name(),
+                through_depth(&c.reference.spec),
+                c.reference.spec.steps_per_period
+            ),
+            CaseSpec::BarAgainst(c) => format!(
+                "-vs-{}-e{}-n{}",
+                c.reference.method.name(),
+                c.reference.spec.elements,
+                c.reference.spec.steps_per_period
+            ),
+            _ => String::new(),
+        };
+        format!(
+            "{}{field}-{mass}-e{elements}-p{ppc}-n{steps}{reference}",
+            method.name()
+        )
     }
 
     /// The methods a case of this study may use.
     pub fn methods(&self) -> &'static [Method] {
+        if self.cantilever.is_some() {
+            return &CANTILEVER_METHODS;
+        }
         match &self.manufactured {
             None => &BAR_METHODS,
             Some(m) if m.dimension == 3 => &MANUFACTURED_METHODS_3D,
@@ -500,7 +719,9 @@ impl DynamicStudy {
                 for &ppc in &s.points_per_cell {
                     for &e in &plan.elements {
                         for &n in &plan.steps_per_period {
-                            let Some(spec) = self.case_spec(s, mass, e, ppc, n) else {
+                            let Some(spec) =
+                                self.case_spec_of(s, method, plan.reference.as_ref(), mass, e, ppc, n)
+                            else {
                                 continue;
                             };
                             out.push(DynamicCase {
@@ -536,7 +757,50 @@ impl DynamicStudy {
             report_file: &self.report_file,
         })?;
         chk.newton("newton", &self.newton)?;
+        let given: Vec<&str> = [
+            ("bar", self.bar.is_some()),
+            ("manufactured", self.manufactured.is_some()),
+            ("cantilever", self.cantilever.is_some()),
+        ]
+        .iter()
+        .filter(|g| g.1)
+        .map(|g| g.0)
+        .collect();
+        if given.len() != 1 {
+            return Err(chk.err(
+                given.last().copied().unwrap_or("bar"),
+                if given.is_empty() {
+                    "(none given)".to_string()
+                } else {
+                    format!("({} given)", given.join(", "))
+                },
+                "exactly one of [bar], [manufactured] and [cantilever] must define the problem",
+            ));
+        }
+        if let Some(c) = &self.cantilever {
+            for (k, v) in [
+                ("cantilever.length", c.length),
+                ("cantilever.depth", c.depth),
+                ("cantilever.young_modulus", c.young_modulus),
+                ("cantilever.load", c.load),
+                ("cantilever.density", c.density),
+                ("cantilever.grid_below", c.grid_below),
+                ("cantilever.grid_margin", c.grid_margin),
+                ("cantilever.periods", c.periods),
+            ] {
+                chk.positive(k, v)?;
+            }
+            // The period is measured from two downward crossings of half the peak deflection.
+            if c.periods < 1.5 {
+                return Err(chk.err(
+                    "cantilever.periods",
+                    c.periods,
+                    "must be >= 1.5 (two downward crossings of half the peak deflection)",
+                ));
+            }
+        }
         match (&self.bar, &self.manufactured) {
+            (None, None) => {}
             (Some(b), None) => {
                 for (k, v) in [
                     ("bar.length", b.length),
@@ -568,17 +832,7 @@ impl DynamicStudy {
                     chk.positive(k, v)?;
                 }
             }
-            (b, _) => {
-                return Err(chk.err(
-                    if b.is_some() { "manufactured" } else { "bar" },
-                    if b.is_some() {
-                        "(both given)"
-                    } else {
-                        "(neither given)"
-                    },
-                    "exactly one of [bar] and [manufactured] must define the problem",
-                ))
-            }
+            (Some(_), Some(_)) => unreachable!("one problem section, checked above"),
         }
         chk.non_empty("sweeps", &self.sweeps)?;
         let mut ids = BTreeSet::new();
@@ -597,10 +851,73 @@ impl DynamicStudy {
                     return Err(chk.err(
                         format!("sweeps[{i}].field"),
                         f.name(),
-                        "must be absent for the bar",
+                        "must be absent for the bar and the cantilever",
                     ))
                 }
                 _ => {}
+            }
+            for tier in [Tier::Full, Tier::Quick] {
+                let Some(plan) = s.plan(tier) else { continue };
+                let key = format!(
+                    "sweeps[{i}].{}reference",
+                    if tier == Tier::Quick { "quick." } else { "" }
+                );
+                match (self.manufactured.is_none(), &plan.reference) {
+                    (true, None) if self.cantilever.is_some() => {
+                        return Err(chk.err(
+                            key,
+                            "(missing)",
+                            "is required with [cantilever]: { method, elements, steps_per_period }",
+                        ))
+                    }
+                    (false, Some(_)) => {
+                        return Err(chk.err(
+                            key,
+                            "(given)",
+                            "is for the bar and the cantilever only (the manufactured fields have exact solutions)",
+                        ))
+                    }
+                    (true, Some(r)) => {
+                        if self.cantilever.is_some() {
+                            chk.count(&format!("{key}.elements"), r.elements, 2, 64)?;
+                        } else {
+                            chk.count(&format!("{key}.elements"), r.elements, 1, MAX_ELEMENTS)?;
+                        }
+                        chk.count(&format!("{key}.steps_per_period"), r.steps_per_period, 1, MAX_STEPS_PER_PERIOD)?;
+                        match (r.method, &self.bar) {
+                            (Some(m), None) => m
+                                .expect_one_of("dynamic cantilever", &CANTILEVER_METHODS)
+                                .map_err(|e| chk.err(format!("{key}.method"), m.name(), e.allowed))?,
+                            // The bar's field is measured at the points' X by the reference's
+                            // shape functions: a line-element reference.
+                            (Some(m), Some(_)) => m
+                                .expect_one_of(
+                                    "bar's reference (its field is read between the nodes)",
+                                    &[Method::FEM_LINEAR, Method::FEM_QUADRATIC],
+                                )
+                                .map_err(|e| chk.err(format!("{key}.method"), m.name(), e.allowed))?,
+                            (None, Some(_)) => {
+                                return Err(chk.err(
+                                    format!("{key}.method"),
+                                    "(missing)",
+                                    "is required for the bar: fem-linear or fem-quadratic",
+                                ))
+                            }
+                            (None, None) => {}
+                        }
+                        // The history error samples the reference at the case's instants.
+                        for &n in &plan.steps_per_period {
+                            if n > 0 && r.steps_per_period % n != 0 {
+                                return Err(chk.err(
+                                    format!("{key}.steps_per_period"),
+                                    r.steps_per_period,
+                                    format!("must be a whole multiple of every case's steps_per_period ({n} is not a divisor)"),
+                                ));
+                            }
+                        }
+                    }
+                    (_, None) => {}
+                }
             }
             chk.non_empty(&format!("sweeps[{i}].mass"), &s.mass)?;
             chk.non_empty(&format!("sweeps[{i}].points_per_cell"), &s.points_per_cell)?;
@@ -622,6 +939,8 @@ impl DynamicStudy {
                     m.expect_one_of(
                         if self.bar.is_some() {
                             "bar"
+                        } else if self.cantilever.is_some() {
+                            "dynamic cantilever"
                         } else {
                             "dynamic manufactured"
                         },
@@ -703,8 +1022,12 @@ impl DynamicStudy {
                 (FigureKind::History, Some(m)) => {
                     return Err(chk.err(k("measure"), m.name(), "must be absent for history figures"))
                 }
-                (FigureKind::History, None) if self.bar.is_none() => {
-                    return Err(chk.err(k("kind"), "history", "is drawn for the bar only"))
+                (FigureKind::History, None) if self.manufactured.is_some() => {
+                    return Err(chk.err(
+                        k("kind"),
+                        "history",
+                        "is drawn for the bar and the cantilever only",
+                    ))
                 }
                 _ => {}
             }

@@ -43,6 +43,16 @@ pub struct DynamicRecord {
     pub measured_period: Option<f64>,
     pub period_error: Option<f64>,
     pub energy_drift: Option<f64>,
+    /// The cantilever: the tip deflection history's error against the sweep's reference
+    /// ([`DynamicMeasure::Tip`]), and the largest downward tip deflection.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tip_error: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_deflection: Option<f64>,
+    /// Why the sweep's reference analysis has no result (its cases then have no reference
+    /// measures).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_failure: Option<String>,
     pub points: usize,
 }
 
@@ -55,6 +65,7 @@ impl DynamicRecord {
             DynamicMeasure::Stress => self.stress_error,
             DynamicMeasure::Period => self.period_error,
             DynamicMeasure::Energy => self.energy_drift,
+            DynamicMeasure::Tip => self.tip_error,
         }
     }
     pub fn series(&self) -> Series {
@@ -110,7 +121,8 @@ pub struct RateRecord {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct DynamicMeasures {
     pub rates: Vec<RateRecord>,
-    /// The period of the motion: the bar's 4L/c, the manufactured forcing's 2/c.
+    /// The period of the motion: the bar's 4L/c, the manufactured forcing's 2/c; the
+    /// cantilever's time unit T₁ (its periods are measured against its references).
     pub exact_period: f64,
 }
 
