@@ -107,7 +107,7 @@ pub struct Newmark {
 /// and the high-frequency modes damped to the spectral radius ρ∞ (ρ∞ = 1 has no dissipation).
 /// The internal force at the weighted instant is taken as the weighted force,
 /// f_int(u_{n+1−α_f}) ≈ (1 − α_f) f_int(u_{n+1}) + α_f f_int(u_n) (the form of Kuhl & Crisfield,
-/// *Int. J. Numer. Meth. Engng* 45 (1999) 569, §3.2, which keeps the updated-Lagrangian
+/// *Int. J. Numer. Meth. Engng* 45 (1999) 569, which keeps the updated-Lagrangian
 /// configuration of each step; the two agree for a linear f_int). Divided by 1 − α_f, a step
 /// solves
 ///
