@@ -233,7 +233,16 @@ fn rates(name: &str, r: &Value, out: &mut MethodsResults) {
             slope: f(&rate["slope"]),
             levels: levels.clone(),
             expected,
-            pass: rate["pass"].as_bool(),
+            // A dynamics study keeps its verdicts among its checks, named by the rate's sweep,
+            // method, mass and measure.
+            pass: rate["pass"].as_bool().or_else(|| {
+                let id = format!("{sweep}-{}-{}-{measure}-rate", method.name(), mass?);
+                r["checks"]
+                    .as_array()?
+                    .iter()
+                    .find(|c| c["id"].as_str() == Some(id.as_str()))?["pass"]
+                    .as_bool()
+            }),
         });
         // FEM series have no points per cell: they join the material point groups of the
         // same field and load only through their own group, so they are not overlaid.
@@ -486,10 +495,27 @@ mod tests {
                                   "levels_used": if refinement == "space" { json!([8, 16]) } else { json!([64, 128]) }}));
             }
         }
+        // A dynamics study's verdicts are its checks, named by sweep, method, mass and measure.
+        let checks = json!([{"id": "time-cpdi-lumped-displacement-rate", "pass": false},
+                            {"id": "space-igimp-consistent-displacement-rate", "pass": true}]);
         let r = json!({"tier": "full", "study": {"problem": "dynamics"}, "cases": cases, "rates": rates,
-                       "sweep_cases": sweep_cases});
+                       "sweep_cases": sweep_cases, "checks": checks});
         let out = collect(&[("vibrating-bar".into(), r)]);
         assert_eq!(out.rates.len(), 9);
+        let verdicts: Vec<(&str, Method, Option<bool>)> = out
+            .rates
+            .iter()
+            .filter(|x| x.pass.is_some())
+            .map(|x| (x.sweep.as_str(), x.method, x.pass))
+            .collect();
+        assert_eq!(
+            verdicts,
+            [
+                ("space", Method::IGIMP, Some(true)),
+                ("time", Method::CPDI, Some(false))
+            ],
+            "{verdicts:?}"
+        );
         assert!(out.rates.iter().all(|x| x.method.uses_material_points()));
         let titles: Vec<&str> = out.groups.iter().map(|g| g.title.as_str()).collect();
         assert_eq!(out.groups.len(), 3, "{titles:?}");
