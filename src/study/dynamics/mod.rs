@@ -777,49 +777,48 @@ impl DynamicStudy {
                 "exactly one of [bar], [manufactured] and [cantilever] must define the problem",
             ));
         }
-        if let Some(c) = &self.cantilever {
-            for (k, v) in [
-                ("cantilever.length", c.length),
-                ("cantilever.depth", c.depth),
-                ("cantilever.young_modulus", c.young_modulus),
-                ("cantilever.load", c.load),
-                ("cantilever.density", c.density),
-                ("cantilever.grid_below", c.grid_below),
-                ("cantilever.grid_margin", c.grid_margin),
-                ("cantilever.periods", c.periods),
-            ] {
+        // A section's positive fields, and its duration: the period is measured between two
+        // downward crossings (`of`), which 1.5 periods contain.
+        let timed_section = |fields: &[(&str, f64)], periods: (&str, f64), of: &str| {
+            for &(k, v) in fields.iter().chain([&periods]) {
                 chk.positive(k, v)?;
             }
-            // The period is measured from two downward crossings of half the peak deflection.
-            if c.periods < 1.5 {
+            if periods.1 < 1.5 {
                 return Err(chk.err(
-                    "cantilever.periods",
-                    c.periods,
-                    "must be >= 1.5 (two downward crossings of half the peak deflection)",
+                    periods.0,
+                    periods.1,
+                    format!("must be >= 1.5 (two downward crossings of {of})"),
                 ));
             }
+            Ok(())
+        };
+        if let Some(c) = &self.cantilever {
+            timed_section(
+                &[
+                    ("cantilever.length", c.length),
+                    ("cantilever.depth", c.depth),
+                    ("cantilever.young_modulus", c.young_modulus),
+                    ("cantilever.load", c.load),
+                    ("cantilever.density", c.density),
+                    ("cantilever.grid_below", c.grid_below),
+                    ("cantilever.grid_margin", c.grid_margin),
+                ],
+                ("cantilever.periods", c.periods),
+                "half the peak deflection",
+            )?;
         }
         match (&self.bar, &self.manufactured) {
             (None, None) => {}
-            (Some(b), None) => {
-                for (k, v) in [
+            (Some(b), None) => timed_section(
+                &[
                     ("bar.length", b.length),
                     ("bar.young_modulus", b.young_modulus),
                     ("bar.density", b.density),
                     ("bar.velocity", b.velocity),
-                    ("bar.periods", b.periods),
-                ] {
-                    chk.positive(k, v)?;
-                }
-                // The period is measured from zero crossings: at least two need 1.5 periods.
-                if b.periods < 1.5 {
-                    return Err(chk.err(
-                        "bar.periods",
-                        b.periods,
-                        "must be >= 1.5 (two zero crossings of the free end)",
-                    ));
-                }
-            }
+                ],
+                ("bar.periods", b.periods),
+                "zero by the free end",
+            )?,
             (None, Some(m)) => {
                 if !matches!(m.dimension, 2 | 3) {
                     return Err(chk.err("manufactured.dimension", m.dimension, "must be 2 or 3"));
