@@ -1,0 +1,242 @@
+//! The roofline of the tangent assembly: the machine's memory bandwidth (a STREAM triad) and
+//! peak FMA rate, and the assembly's achieved flop/s and bytes/s against them.
+//!
+//! `cargo bench --bench roofline -- [2d|3d] [points]` (default: both, 1e5 points each). Prints
+//! the triad bandwidth (best of 10 over three 256 MiB arrays, 24 bytes per element as STREAM
+//! counts them), the FMA peak of the hardware (AVX2 + FMA, 4 lanes, 10 independent chains per
+//! thread, when the CPU has them) and of the build's own target (two-lane SSE2 multiply + add:
+//! the crate is compiled for baseline x86-64, so that is the ceiling its kernels can reach),
+//! then for the filled manufactured square or cube (iGIMP, 2 points per cell per axis, after
+//! one evaluation at a small increment) the tangent assembly's time (best of 3), its flops and
+//! bytes counted from the kernel's loops, and the roofline bound max(flops / peak, bytes /
+//! bandwidth) with the measured time's ratio to it, with and without the time of the points'
+//! constitutive tangents (timed alone, not counted).
+//!
+//! Counts, per point with m support nodes in D dimensions (src/assembly.rs,
+//! `assemble_tangent`): spatial gradients 2 m D² flops; per column (b, k) of the local block
+//! the D × D product C = a G_b V (2 D³ + D² flops) and the column m D × D dot products
+//! (2 m D² flops). Bytes: the local block written and read back (16 (mD)² per point) and, per
+//! run of consecutive points with the same nodes (summed before the scatter), each entry's
+//! value read and written in the sparse matrix (16 (mD)²). Index searches, the constitutive
+//! tangent and the equation lookups are not counted: the bound is a lower one.
+use igimp::load_stepping::LoadStepping;
+use igimp::method::Method;
+use igimp::mpm::MpmSolver;
+use igimp::newton::NonlinearSystem;
+use igimp::problems::manufactured::{self, ManufacturedSpec};
+use rayon::prelude::*;
+use std::hint::black_box;
+use std::time::Instant;
+
+/// Bytes per second of a = b + s c over 2^25-element arrays, best of 10.
+fn triad_bandwidth() -> f64 {
+    let n = 1usize << 25;
+    let chunk = 1 << 16;
+    let (mut a, b, c) = (vec![0.0f64; n], vec![1.0f64; n], vec![2.0f64; n]);
+    let s = 3.0;
+    let mut best = f64::INFINITY;
+    for _ in 0..10 {
+        let t = Instant::now();
+        a.par_chunks_mut(chunk)
+            .zip(b.par_chunks(chunk))
+            .zip(c.par_chunks(chunk))
+            .for_each(|((a, b), c)| {
+                for i in 0..a.len() {
+                    a[i] = b[i] + s * c[i];
+                }
+            });
+        best = best.min(t.elapsed().as_secs_f64());
+        black_box(&a);
+    }
+    24.0 * n as f64 / best
+}
+
+/// Flops of `iters` rounds of 10 independent 4-lane FMA chains (AVX2 + FMA).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn fma_chains(iters: u64) -> f64 {
+    use std::arch::x86_64::*;
+    let mut acc = [_mm256_set1_pd(1.0); 10];
+    let (x, y) = (_mm256_set1_pd(0.999_999), _mm256_set1_pd(1e-7));
+    for _ in 0..iters {
+        for a in acc.iter_mut() {
+            *a = _mm256_fmadd_pd(*a, x, y);
+        }
+    }
+    let mut out = [0.0; 4];
+    let mut sum = _mm256_setzero_pd();
+    for a in acc {
+        sum = _mm256_add_pd(sum, a);
+    }
+    _mm256_storeu_pd(out.as_mut_ptr(), sum);
+    black_box(out);
+    (iters * 10 * 4 * 2) as f64
+}
+
+/// Flops of `iters` rounds of 12 independent multiply-add chains as the build compiles them
+/// (baseline x86-64: SSE2, two lanes, no fused multiply-add).
+fn mul_add_chains(iters: u64) -> f64 {
+    let mut acc = [1.0f64; 12];
+    let (x, y) = (black_box(0.999_999), black_box(1e-7));
+    for _ in 0..iters {
+        for a in acc.iter_mut() {
+            *a = *a * x + y;
+        }
+    }
+    black_box(acc);
+    (iters * 12 * 2) as f64
+}
+
+/// Flop/s of `kernel` run on every thread at once, best of 5.
+fn peak(kernel: impl Fn(u64) -> f64 + Sync) -> f64 {
+    let threads = rayon::current_num_threads();
+    let iters = 50_000_000;
+    let mut best: f64 = 0.0;
+    for _ in 0..5 {
+        let t = Instant::now();
+        let flops: f64 = (0..threads).into_par_iter().map(|_| kernel(iters)).sum();
+        best = best.max(flops / t.elapsed().as_secs_f64());
+    }
+    best
+}
+
+/// What one assembly measured: its time (best of 3), the time of its points' constitutive
+/// tangents alone (best of 3: the part the counts leave out), and the counted flops and bytes.
+struct Assembly {
+    time: f64,
+    constitutive: f64,
+    flops: f64,
+    bytes: f64,
+}
+
+/// [`Assembly`] of the solver's first step at a small increment.
+fn assembly<const D: usize>(mut solver: MpmSolver<D>) -> Assembly {
+    let load = 1.0 / solver.load_steps() as f64;
+    solver
+        .with_step_system(load, |sys| {
+            let n = sys.num_unknowns();
+            let u: Vec<f64> = (0..n)
+                .map(|i| 1e-4 * ((i * 7919 % 101) as f64 / 50.0 - 1.0))
+                .collect();
+            let mut r = vec![0.0; n];
+            sys.evaluate(&u, &mut r).expect("an evaluation");
+            let mut best = f64::INFINITY;
+            for _ in 0..3 {
+                let t = Instant::now();
+                sys.assemble_tangent();
+                best = best.min(t.elapsed().as_secs_f64());
+            }
+            let mut constitutive = f64::INFINITY;
+            for _ in 0..3 {
+                let t = Instant::now();
+                let sum: f64 = (0..sys.states.len())
+                    .into_par_iter()
+                    .map(|p| {
+                        let trial = sys.trials[p].as_ref().expect("evaluated");
+                        trial.spatial_tangent(sys.model, &sys.states[p])[(0, 0)]
+                    })
+                    .sum();
+                black_box(sum);
+                constitutive = constitutive.min(t.elapsed().as_secs_f64());
+            }
+            let (d, table) = (D as f64, sys.table);
+            let (mut flops, mut bytes) = (0.0, 0.0);
+            let mut previous: Option<&[usize]> = None;
+            for p in 0..table.num_points() {
+                let nodes = table.point(p).0;
+                let m = nodes.len() as f64;
+                let md2 = (m * d) * (m * d);
+                flops += 2.0 * m * d * d + m * d * (2.0 * d * d * d + d * d + 2.0 * m * d * d);
+                bytes += 16.0 * md2;
+                if previous != Some(nodes) {
+                    bytes += 16.0 * md2;
+                }
+                previous = Some(nodes);
+            }
+            Assembly {
+                time: best,
+                constitutive,
+                flops,
+                bytes,
+            }
+        })
+        .expect("the first step's system")
+}
+
+fn report(label: &str, a: &Assembly, peak: f64, bandwidth: f64) {
+    let Assembly {
+        time,
+        constitutive,
+        flops,
+        bytes,
+    } = *a;
+    let bound = (flops / peak).max(bytes / bandwidth);
+    println!(
+        "{label}: assembly {time:.3} s, of which constitutive tangents {constitutive:.3} s | {:.2} Gflop ({:.2} Gflop/s, {:.0} % of the build's peak) | {:.2} GB ({:.2} GB/s, {:.0} % of the triad) | roofline bound {bound:.3} s ({}) | measured / bound {:.2}, without the constitutive tangents {:.2}",
+        flops / 1e9,
+        flops / time / 1e9,
+        100.0 * flops / time / peak,
+        bytes / 1e9,
+        bytes / time / 1e9,
+        100.0 * bytes / time / bandwidth,
+        if flops / peak > bytes / bandwidth { "compute" } else { "memory" },
+        time / bound,
+        (time - constitutive) / bound
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
+    let dims: Vec<usize> = match args.first().map(String::as_str) {
+        Some("2d") => vec![2],
+        Some("3d") => vec![3],
+        _ => vec![2, 3],
+    };
+    let points: f64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1e5);
+    let bandwidth = triad_bandwidth();
+    #[cfg(target_arch = "x86_64")]
+    let hardware = (is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma"))
+        .then(|| peak(|i| unsafe { fma_chains(i) }));
+    #[cfg(not(target_arch = "x86_64"))]
+    let hardware: Option<f64> = None;
+    let build = peak(mul_add_chains);
+    println!(
+        "{} threads | triad {:.2} GB/s | FMA peak {} | the build's multiply-add peak {:.2} Gflop/s",
+        rayon::current_num_threads(),
+        bandwidth / 1e9,
+        hardware.map_or("— (no AVX2 + FMA)".to_string(), |p| format!(
+            "{:.2} Gflop/s (AVX2 + FMA)",
+            p / 1e9
+        )),
+        build / 1e9
+    );
+    for d in dims {
+        // (2 cells)^D points per cell.
+        let cells = (points / (1 << d) as f64).powf(1.0 / d as f64).round().max(2.0) as usize;
+        let spec = ManufacturedSpec {
+            cells,
+            dimension: d,
+            ..Default::default()
+        };
+        let counts = if d == 2 {
+            assembly(manufactured::mpm_solver(&spec, Method::IGIMP).expect("plane solver"))
+        } else {
+            assembly(
+                igimp::problems::manufactured3d::mpm_solver_3d(&spec, Method::IGIMP).expect("cube solver"),
+            )
+        };
+        let n = cells.pow(d as u32) * (1 << d);
+        report(
+            &format!("{d}D, {n} points ({cells} cells per side)"),
+            &counts,
+            build,
+            bandwidth,
+        );
+        if let Some(h) = hardware {
+            println!(
+                "    against the hardware FMA peak: {:.1} %",
+                100.0 * counts.flops / counts.time / h
+            );
+        }
+    }
+}
