@@ -193,6 +193,32 @@ fn main() {
         _ => vec![2, 3],
     };
     let points: f64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1e5);
+    // `ROOFLINE_ASSEMBLY_ONLY=1`: the assembly alone, for a profiler (`perf record`); the
+    // machine's figures are then not measured and the ratios not printed.
+    let assembly_only = std::env::var("ROOFLINE_ASSEMBLY_ONLY").is_ok_and(|v| v == "1");
+    if assembly_only {
+        for d in dims {
+            let cells = (points / (1 << d) as f64).powf(1.0 / d as f64).round().max(2.0) as usize;
+            let spec = ManufacturedSpec {
+                cells,
+                dimension: d,
+                ..Default::default()
+            };
+            let a = if d == 2 {
+                assembly(manufactured::mpm_solver(&spec, Method::IGIMP).expect("plane solver"))
+            } else {
+                assembly(
+                    igimp::problems::manufactured3d::mpm_solver_3d(&spec, Method::IGIMP)
+                        .expect("cube solver"),
+                )
+            };
+            println!(
+                "{d}D, {cells} cells per side: assembly {:.3} s, constitutive {:.3} s",
+                a.time, a.constitutive
+            );
+        }
+        return;
+    }
     let bandwidth = triad_bandwidth();
     #[cfg(target_arch = "x86_64")]
     let hardware = (is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma"))
