@@ -333,8 +333,11 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             let len = end - start;
             let m_max = (start..end).map(|p| table.point(p).0.len()).max().unwrap_or(0);
             let stride_k = (m_max * D) * (m_max * D);
-            local.clear();
-            local.resize(len * stride_k, 0.0);
+            // Every entry a point's block reads is written first: the buffer only grows, and
+            // is not cleared (zero-filling it was 5 % of a 3D assembly, perf 2026-12-04).
+            if local.len() < len * stride_k {
+                local.resize(len * stride_k, 0.0);
+            }
             eq_buf.clear();
             eq_buf.resize(len * stride_eq, None);
             sizes.clear();
@@ -387,7 +390,9 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                                     if i == k && mass != 0.0 {
                                         sum += mass * weights[ka] * weights[kb];
                                     }
-                                    kl[(ka * D + i) * md + kb * D + k] = sum;
+                                    // Column-major: the block's column (b, k) is written
+                                    // here and read by the scatter contiguously.
+                                    kl[(kb * D + k) * md + ka * D + i] = sum;
                                 }
                             }
                         }
@@ -409,7 +414,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                         let dof = nodes[ri / D] * D + ri % D;
                         for (ci, col) in eqs.iter().enumerate() {
                             if let Some(col) = *col {
-                                lin.rows.push((dof, col, kl[ri * md + ci]));
+                                lin.rows.push((dof, col, kl[ci * md + ri]));
                             }
                         }
                     }
@@ -445,7 +450,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                             let mut hint = usize::MAX;
                             for (ri, row) in eqs.iter().enumerate() {
                                 if let Some(row) = *row {
-                                    let e = ri * md + ci;
+                                    let e = ci * md + ri;
                                     let mut v = local[first * stride_k + e];
                                     for i in first + 1..end {
                                         v += local[i * stride_k + e];
