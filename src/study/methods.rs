@@ -233,10 +233,20 @@ fn rates(name: &str, r: &Value, out: &mut MethodsResults) {
             slope: f(&rate["slope"]),
             levels: levels.clone(),
             expected,
-            // A dynamics study keeps its verdicts among its checks, named by the rate's sweep,
-            // method, mass and measure.
+            // The dynamics and manufactured studies keep their verdicts among their checks,
+            // named by the rate's sweep, method, (mass | domain update and points per cell)
+            // and measure.
             pass: rate["pass"].as_bool().or_else(|| {
-                let id = format!("{sweep}-{}-{}-{measure}-rate", method.name(), mass?);
+                let id = match mass {
+                    Some(mass) => format!("{sweep}-{}-{mass}-{measure}-rate", method.name()),
+                    None => crate::study::manufactured::rate_check_id(
+                        sweep,
+                        method,
+                        serde_json::from_value(rate["domain_update"].clone()).ok(),
+                        ppc.map(|p| p as usize),
+                        measure,
+                    ),
+                };
                 r["checks"]
                     .as_array()?
                     .iter()
@@ -531,6 +541,26 @@ mod tests {
         );
         // Each lumped series holds its own two cases, not the consistent ones.
         assert!(time.series.iter().all(|(_, p)| p.len() == 2), "{:?}", time.series);
+    }
+
+    /// A manufactured study's rate finds its verdict in the check named by its sweep, method,
+    /// domain update, points per cell and measure; a rate without a check has none.
+    #[test]
+    fn manufactured_rates_take_their_checks_verdicts() {
+        let rates = json!([
+            {"sweep": "axis", "method": "igimp", "domain_update": "stretch", "points_per_cell": 2,
+             "measure": "displacement", "slope": 2.0, "cells_used": [8, 16]},
+            {"sweep": "axis", "method": "igimp", "domain_update": "f-diagonal", "points_per_cell": 2,
+             "measure": "displacement", "slope": 1.0, "cells_used": [8, 16]},
+            {"sweep": "axis", "method": "fem-q4", "measure": "stress", "slope": 1.0, "cells_used": [8, 16]}
+        ]);
+        let checks = json!([{"id": "axis-igimp-stretch-p2-displacement-rate", "pass": true},
+                            {"id": "axis-fem-q4-stress-rate", "pass": false}]);
+        let r = json!({"tier": "full", "study": {"problem": "manufactured"}, "cases": [], "rates": rates,
+                       "sweep_cases": {"axis": []}, "checks": checks});
+        let out = collect(&[("manufactured".into(), r)]);
+        let verdicts: Vec<Option<bool>> = out.rates.iter().map(|x| x.pass).collect();
+        assert_eq!(verdicts, [Some(true), None, Some(false)]);
     }
 
     /// A column-type results file with three methods in one group and one FEM series: one

@@ -1,6 +1,6 @@
 //! Fitted rates of every series and the `[[expect_rate]]` checks.
 
-use super::plan::update_tag;
+use super::rate_check_id;
 use super::records::{ExpectedBand, ManufacturedResults, RateRecord, Series};
 use super::ErrorMeasure;
 use crate::mpm::DomainUpdate;
@@ -73,14 +73,12 @@ pub(super) fn checks(results: &ManufacturedResults) -> Vec<CheckRecord> {
             let r = rates
                 .iter()
                 .find(|r| r.sweep == x.sweep && r.series == s && r.measure == x.measure);
-            let id = format!(
-                "{}-{}{}{}-{}-rate",
-                x.sweep,
-                x.method.name(),
-                s.domain_update
-                    .map_or(String::new(), |u| format!("-{}", update_tag(u))),
-                s.points_per_cell.map_or(String::new(), |p| format!("-p{p}")),
-                x.measure.name()
+            let id = rate_check_id(
+                &x.sweep,
+                x.method,
+                s.domain_update,
+                s.points_per_cell,
+                x.measure.name(),
             );
             let what = format!(
                 "{} of {} in sweep `{}`, fitted over cells {:?}",

@@ -14,6 +14,23 @@ use crate::method::Method;
 use crate::mpm::DomainUpdate;
 pub use crate::problems::manufactured::Field;
 use crate::problems::manufactured::ManufacturedSpec;
+
+/// The id of the check of one series' rate: `<sweep>-<method>[-<update>][-p<ppc>]-<measure>-rate`
+/// (the cross-method report finds a rate's verdict by it).
+pub fn rate_check_id(
+    sweep: &str,
+    method: Method,
+    domain_update: Option<DomainUpdate>,
+    points_per_cell: Option<usize>,
+    measure: &str,
+) -> String {
+    format!(
+        "{sweep}-{}{}{}-{measure}-rate",
+        method.name(),
+        domain_update.map_or(String::new(), |u| format!("-{}", plan::update_tag(u))),
+        points_per_cell.map_or(String::new(), |p| format!("-p{p}")),
+    )
+}
 /// A case's material or Gauss point, as the point files and `domains.json` store it.
 pub use crate::problems::manufactured::PointValue;
 use serde::{Deserialize, Serialize};
