@@ -163,6 +163,23 @@ fn assembly<const D: usize>(mut solver: MpmSolver<D>) -> Assembly {
         .expect("the first step's system")
 }
 
+/// (cells per side, points, [`Assembly`]) of the filled manufactured square (`d` = 2) or cube
+/// (3) with about `points` points, 2 per cell per axis.
+fn filled_field_assembly(d: usize, points: f64) -> (usize, usize, Assembly) {
+    let cells = (points / (1 << d) as f64).powf(1.0 / d as f64).round().max(2.0) as usize;
+    let spec = ManufacturedSpec {
+        cells,
+        dimension: d,
+        ..Default::default()
+    };
+    let a = if d == 2 {
+        assembly(manufactured::mpm_solver(&spec, Method::IGIMP).expect("plane solver"))
+    } else {
+        assembly(igimp::problems::manufactured3d::mpm_solver_3d(&spec, Method::IGIMP).expect("cube solver"))
+    };
+    (cells, cells.pow(d as u32) * (1 << d), a)
+}
+
 fn report(label: &str, a: &Assembly, peak: f64, bandwidth: f64) {
     let Assembly {
         time,
@@ -198,20 +215,7 @@ fn main() {
     let assembly_only = std::env::var("ROOFLINE_ASSEMBLY_ONLY").is_ok_and(|v| v == "1");
     if assembly_only {
         for d in dims {
-            let cells = (points / (1 << d) as f64).powf(1.0 / d as f64).round().max(2.0) as usize;
-            let spec = ManufacturedSpec {
-                cells,
-                dimension: d,
-                ..Default::default()
-            };
-            let a = if d == 2 {
-                assembly(manufactured::mpm_solver(&spec, Method::IGIMP).expect("plane solver"))
-            } else {
-                assembly(
-                    igimp::problems::manufactured3d::mpm_solver_3d(&spec, Method::IGIMP)
-                        .expect("cube solver"),
-                )
-            };
+            let (cells, _, a) = filled_field_assembly(d, points);
             println!(
                 "{d}D, {cells} cells per side: assembly {:.3} s, constitutive {:.3} s",
                 a.time, a.constitutive
@@ -237,21 +241,7 @@ fn main() {
         build / 1e9
     );
     for d in dims {
-        // (2 cells)^D points per cell.
-        let cells = (points / (1 << d) as f64).powf(1.0 / d as f64).round().max(2.0) as usize;
-        let spec = ManufacturedSpec {
-            cells,
-            dimension: d,
-            ..Default::default()
-        };
-        let counts = if d == 2 {
-            assembly(manufactured::mpm_solver(&spec, Method::IGIMP).expect("plane solver"))
-        } else {
-            assembly(
-                igimp::problems::manufactured3d::mpm_solver_3d(&spec, Method::IGIMP).expect("cube solver"),
-            )
-        };
-        let n = cells.pow(d as u32) * (1 << d);
+        let (cells, n, counts) = filled_field_assembly(d, points);
         report(
             &format!("{d}D, {n} points ({cells} cells per side)"),
             &counts,

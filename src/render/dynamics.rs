@@ -262,23 +262,21 @@ fn render_figure(
         }
         FigureKind::History if results.study.cantilever.is_some() => {
             let length = results.study.cantilever.as_ref().map_or(1.0, |c| c.length);
-            let series: Vec<ProfileSeries> = results
-                .sweep(&f.sweep)
-                .into_iter()
-                .filter_map(|c| {
-                    let h = histories.get(&c.id)?;
-                    Some(ProfileSeries {
-                        label: format!(
-                            "{} ({} el. through the depth, {}/T₁)",
-                            c.method.label(),
-                            c.elements,
-                            c.steps_per_period
-                        ),
-                        // Seconds and per cent of L: the axes label whole numbers.
-                        points: h.iter().map(|p| (p[0], 100.0 * p[1] / length)).collect(),
-                    })
-                })
-                .collect();
+            // Seconds and per cent of L: the axes label whole numbers.
+            let series = history_series(
+                results,
+                histories,
+                &f.sweep,
+                |c| {
+                    format!(
+                        "{} ({} el. through the depth, {}/T₁)",
+                        c.method.label(),
+                        c.elements,
+                        c.steps_per_period
+                    )
+                },
+                |p| (p[0], 100.0 * p[1] / length),
+            );
             if series.is_empty() {
                 return Ok(None);
             }
@@ -292,23 +290,21 @@ fn render_figure(
             };
             let t_period = results.measures.exact_period;
             let amplitude = b.velocity / (2.0 * std::f64::consts::PI / t_period);
-            let series: Vec<ProfileSeries> = results
-                .sweep(&f.sweep)
-                .into_iter()
-                .filter_map(|c| {
-                    let h = histories.get(&c.id)?;
-                    Some(ProfileSeries {
-                        label: format!(
-                            "{} ({} mass, {} el., {}/T)",
-                            c.method.label(),
-                            c.mass.name(),
-                            c.elements,
-                            c.steps_per_period
-                        ),
-                        points: h.iter().map(|p| (p[0] / t_period, p[1] / amplitude)).collect(),
-                    })
-                })
-                .collect();
+            let series = history_series(
+                results,
+                histories,
+                &f.sweep,
+                |c| {
+                    format!(
+                        "{} ({} mass, {} el., {}/T)",
+                        c.method.label(),
+                        c.mass.name(),
+                        c.elements,
+                        c.steps_per_period
+                    )
+                },
+                |p| (p[0] / t_period, p[1] / amplitude),
+            );
             if series.is_empty() {
                 return Ok(None);
             }
@@ -327,6 +323,28 @@ fn render_figure(
                 .map_err(err)
         }
     }
+}
+
+/// One series per case of `sweep` with a stored history (t, u), labelled by `label` and its
+/// samples scaled by `point`.
+fn history_series(
+    results: &DynamicResults,
+    histories: &BTreeMap<String, History>,
+    sweep: &str,
+    label: impl Fn(&crate::study::dynamics::records::DynamicRecord) -> String,
+    point: impl Fn(&[f64; 2]) -> (f64, f64),
+) -> Vec<ProfileSeries> {
+    results
+        .sweep(sweep)
+        .into_iter()
+        .filter_map(|c| {
+            let h = histories.get(&c.id)?;
+            Some(ProfileSeries {
+                label: label(c),
+                points: h.iter().map(&point).collect(),
+            })
+        })
+        .collect()
 }
 
 /// Render the report and figures from `dir`'s `results.json` and `histories.json`.

@@ -17,7 +17,7 @@ fn study() -> DynamicStudy {
 }
 
 /// Every check evaluated and passed.
-fn assert_all_pass(checks: &[igimp::study::checks::CheckRecord]) {
+pub fn assert_all_pass(checks: &[igimp::study::checks::CheckRecord]) {
     for c in checks {
         assert_eq!(
             c.pass,

@@ -360,6 +360,67 @@ fn slope(levels: &[usize], errors: &[f64]) -> f64 {
     igimp::norms::fitted_rate(&h, errors).expect("a rate")
 }
 
+/// The dynamic axis-aligned field on `cells` cells at `steps` per period, Newmark (`None`) or
+/// generalised-α of spectral radius `rho_infinity`.
+fn axis_field(
+    cells: usize,
+    steps: usize,
+    rho_infinity: Option<f64>,
+) -> igimp::problems::manufactured_dynamic::DynamicManufacturedSpec {
+    igimp::problems::manufactured_dynamic::DynamicManufacturedSpec {
+        cells,
+        steps_per_period: steps,
+        rho_infinity,
+        ..Default::default()
+    }
+}
+
+/// Q8's displacement errors against the exact motion on 8 × 8 elements at each of `levels`
+/// steps per period.
+fn q8_time_errors(levels: &[usize], rho_infinity: Option<f64>) -> Vec<f64> {
+    use igimp::problems::manufactured_dynamic as mms;
+    levels
+        .iter()
+        .map(|&n| {
+            mms::solve(&axis_field(8, n, rho_infinity), Method::FEM_Q8)
+                .unwrap()
+                .errors
+                .unwrap()
+                .displacement
+        })
+        .collect()
+}
+
+/// Temporal self-convergence of `method` on `cells` cells: the slopes of the successive
+/// differences of the points' end positions over `levels` steps per period (the space error
+/// is common to every level).
+fn self_convergence(method: Method, cells: usize, levels: &[usize], rho_infinity: Option<f64>) -> Vec<f64> {
+    use igimp::problems::manufactured_dynamic as mms;
+    let ends: Vec<Vec<[f64; 2]>> = levels
+        .iter()
+        .map(|&n| {
+            let s = mms::solve(&axis_field(cells, n, rho_infinity), method).unwrap();
+            assert!(
+                s.failure.is_none(),
+                "{method:?} at {n} steps per period: {:?}",
+                s.failure
+            );
+            s.points.iter().map(|p| p.x).collect()
+        })
+        .collect();
+    let diffs: Vec<f64> = ends
+        .windows(2)
+        .map(|w| {
+            w[0].iter()
+                .zip(&w[1])
+                .map(|(a, b)| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .collect();
+    diffs.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
+}
+
 /// Newmark's order in time on the dynamic manufactured axis-aligned field at fixed space.
 ///
 /// Q8 on 8 × 8 elements against the exact motion: its space error (2.9e-4) is below the time
@@ -379,52 +440,14 @@ fn slope(levels: &[usize], errors: &[f64]) -> f64 {
 /// 0.06, 1.00, 0.25). Measured 2026-12-04, reference/README item 48.
 #[test]
 fn newmark_is_second_order_in_time_on_the_dynamic_manufactured_field() {
-    use igimp::problems::manufactured_dynamic::{self as mms, DynamicManufacturedSpec};
-    let spec = |cells, n| DynamicManufacturedSpec {
-        cells,
-        steps_per_period: n,
-        ..Default::default()
-    };
     let levels = [8, 16, 32, 64];
-    let q8: Vec<f64> = levels
-        .iter()
-        .map(|&n| {
-            mms::solve(&spec(8, n), Method::FEM_Q8)
-                .unwrap()
-                .errors
-                .unwrap()
-                .displacement
-        })
-        .collect();
+    let q8 = q8_time_errors(&levels, None);
     let rate = slope(&levels, &q8);
     println!("Q8 {q8:?}: {rate:.3}");
     assert!((rate - 2.0).abs() < 0.1, "Q8 time rate {rate} ({q8:?})");
     // Slopes of the successive differences of the end positions, 8..128 steps per period.
-    let self_convergence = |method: Method, cells: usize| -> Vec<f64> {
-        let ends: Vec<Vec<[f64; 2]>> = [8, 16, 32, 64, 128]
-            .iter()
-            .map(|&n| {
-                let s = mms::solve(&spec(cells, n), method).unwrap();
-                assert!(
-                    s.failure.is_none(),
-                    "{method:?} at {n} steps per period: {:?}",
-                    s.failure
-                );
-                s.points.iter().map(|p| p.x).collect()
-            })
-            .collect();
-        let diffs: Vec<f64> = ends
-            .windows(2)
-            .map(|w| {
-                w[0].iter()
-                    .zip(&w[1])
-                    .map(|(a, b)| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2))
-                    .sum::<f64>()
-                    .sqrt()
-            })
-            .collect();
-        diffs.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
-    };
+    let self_convergence =
+        |method: Method, cells: usize| self_convergence(method, cells, &[8, 16, 32, 64, 128], None);
     for basis in Basis::ALL.into_iter().filter(|&b| b != Basis::Mpm) {
         let method = Method::MaterialPoint(basis);
         let (coarse, fine) = (self_convergence(method, 8), self_convergence(method, 16));
@@ -636,49 +659,15 @@ fn generalized_alpha_tangent_and_order_in_the_solvers() {
     println!("Q8 generalised-α tangent: {err:.2e}");
     assert!(err < 1e-6, "Q8 generalised-α: relative tangent error {err:e}");
 
-    let axis = |cells, n| DynamicManufacturedSpec {
-        cells,
-        steps_per_period: n,
-        rho_infinity: Some(0.8),
-        ..Default::default()
-    };
     let levels = [8, 16, 32, 64];
-    let q8: Vec<f64> = levels
-        .iter()
-        .map(|&n| {
-            mms::solve(&axis(8, n), Method::FEM_Q8)
-                .unwrap()
-                .errors
-                .unwrap()
-                .displacement
-        })
-        .collect();
+    let q8 = q8_time_errors(&levels, Some(0.8));
     let rate = slope(&levels, &q8);
     println!("Q8 generalised-α {q8:?}: {rate:.3}");
     assert!(
         (rate - 2.0).abs() < 0.1,
         "Q8 generalised-α time rate {rate} ({q8:?})"
     );
-    let ends: Vec<Vec<[f64; 2]>> = [8, 16, 32]
-        .iter()
-        .map(|&n| {
-            let s = mms::solve(&axis(16, n), Method::IGIMP).unwrap();
-            assert!(
-                s.failure.is_none(),
-                "iGIMP at {n} steps per period: {:?}",
-                s.failure
-            );
-            s.points.iter().map(|p| p.x).collect()
-        })
-        .collect();
-    let diff = |a: &[[f64; 2]], b: &[[f64; 2]]| {
-        a.iter()
-            .zip(b)
-            .map(|(a, b)| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2))
-            .sum::<f64>()
-            .sqrt()
-    };
-    let first = (diff(&ends[0], &ends[1]) / diff(&ends[1], &ends[2])).log2();
+    let first = self_convergence(Method::IGIMP, 16, &[8, 16, 32], Some(0.8))[0];
     println!("iGIMP generalised-α first doubling: {first:.3}");
     // Measured 2.09 (Newmark: 2.00 to 2.07, band ±0.1 above); band ±0.15.
     assert!(
