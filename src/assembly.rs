@@ -3,9 +3,10 @@
 //! comparators (points = Gauss points, supports = element shape functions).
 //!
 //! Each point contributes `f_p = [G]ᵀ{σ} V_p` (eq 29) and `K_p = [G]ᵀ[a][G] V_p` (eq 27),
-//! where \[G\] holds ∂S/∂x = ∂S/∂X̃ · ΔF⁻¹ (eqs 36, 41). Points are evaluated in parallel into
-//! per-point slots; the scatter runs serially in point order, so results do not depend on
-//! the thread count.
+//! where \[G\] holds ∂S/∂x = ∂S/∂X̃ · ΔF⁻¹ (eqs 36, 41). The residual's points are evaluated
+//! in parallel into per-point slots and summed in point order; the tangent's threads each own
+//! a block of columns and add every point's block to them in point order, so results do not
+//! depend on the thread count.
 
 use crate::constitutive::ConstitutiveModel;
 pub use crate::dofs::{DofMap, SupportTable, MAX_POINT_NODES};
@@ -303,11 +304,6 @@ impl<const D: usize> LoadStepSystem<'_, D> {
     }
 
     fn assemble_tangent_untimed(&mut self) {
-        // Points whose local matrices are buffered at once: bounds the buffer's memory; the
-        // result does not depend on it (entries take contributions in point order). Not
-        // tuned.
-        const POINTS_PER_CHUNK: usize = 4096;
-        let stride_eq = MAX_POINT_NODES * D;
         self.matrix.clear_values();
         if let Some(lin) = self.linearised.as_deref_mut() {
             lin.rows.clear();
@@ -315,152 +311,34 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             lin.fixed_t.clone_from(self.fixed_forces);
         }
         let n = self.states.len();
-        let (table, dofs, model, states, trials) =
-            (self.table, self.dofs, self.model, self.states, &*self.trials);
         #[cfg(feature = "seeded-bugs")]
         let inertia = self
             .inertia
             .filter(|_| !crate::seeded::active(crate::seeded::Bug::NoMassInTangent));
         #[cfg(not(feature = "seeded-bugs"))]
         let inertia = self.inertia;
-        let mut local: Vec<f64> = Vec::new();
-        let mut eq_buf: Vec<Option<usize>> = Vec::new();
-        let mut sizes: Vec<usize> = Vec::new();
-        let mut groups: Vec<usize> = Vec::new();
+        let kernel = PointKernel {
+            table: self.table,
+            dofs: self.dofs,
+            model: self.model,
+            states: self.states,
+            trials: self.trials,
+            inertia,
+        };
+        let runs = kernel.runs(n);
+        // Each thread owns a block of columns and walks every run in point order, forming the
+        // blocks of the runs that reach its columns (a run straddling two blocks is formed by
+        // both) and adding them at once: no buffer of every point's block (4.6 KB a 3D point,
+        // written and read again at memory speed), and every entry sums the same terms in the
+        // same order whatever the thread count.
         let threads = rayon::current_num_threads();
-        for start in (0..n).step_by(POINTS_PER_CHUNK) {
-            let end = (start + POINTS_PER_CHUNK).min(n);
-            let len = end - start;
-            let m_max = (start..end).map(|p| table.point(p).0.len()).max().unwrap_or(0);
-            let stride_k = (m_max * D) * (m_max * D);
-            // Every entry a point's block reads is written first: the buffer only grows, and
-            // is not cleared (zero-filling it was 5 % of a 3D assembly, perf 2026-12-04).
-            if local.len() < len * stride_k {
-                local.resize(len * stride_k, 0.0);
-            }
-            eq_buf.clear();
-            eq_buf.resize(len * stride_eq, None);
-            sizes.clear();
-            sizes.resize(len, 0);
-            local
-                .par_chunks_mut(stride_k.max(1))
-                .zip(eq_buf.par_chunks_mut(stride_eq))
-                .zip(sizes.par_iter_mut())
-                .enumerate()
-                .for_each(|(i, ((kl, eqs), size))| {
-                    let p = start + i;
-                    let t = trials[p].as_ref().expect("evaluated");
-                    let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
-                    let (nodes, _, g) = table.point(p);
-                    let inv_t = t.delta_f_inv.transpose();
-                    for k in 0..nodes.len() {
-                        gx[k] = inv_t * g[k]; // eq (36)
-                        for a in 0..D {
-                            eqs[k * D + a] = dofs.eq(nodes[k] * D + a);
-                        }
-                    }
-                    let md = nodes.len() * D;
-                    *size = md;
-                    let a = t.spatial_tangent(model, &states[p]);
-                    let v = t.volume;
-                    // The inertia term's α m_p S_a S_b δ_ik (consistent mass).
-                    let mass = inertia
-                        .filter(|i| i.mass == MassMatrix::Consistent)
-                        .map_or(0.0, |i| i.step.tangent_mass_factor() * i.point_masses[p]);
-                    let weights = table.point(p).1;
-                    // K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V.
-                    for kb in 0..nodes.len() {
-                        for k in 0..D {
-                            let mut c = [[0.0; 3]; 3];
-                            for i in 0..D {
-                                for j in 0..D {
-                                    let mut s = 0.0;
-                                    for l in 0..D {
-                                        s += a[(ij(i, j), ij(k, l))] * gx[kb][l];
-                                    }
-                                    c[i][j] = s * v;
-                                }
-                            }
-                            for ka in 0..nodes.len() {
-                                for i in 0..D {
-                                    let mut sum = 0.0;
-                                    for j in 0..D {
-                                        sum += gx[ka][j] * c[i][j];
-                                    }
-                                    if i == k && mass != 0.0 {
-                                        sum += mass * weights[ka] * weights[kb];
-                                    }
-                                    // Column-major: the block's column (b, k) is written
-                                    // here and read by the scatter contiguously.
-                                    kl[(kb * D + k) * md + ka * D + i] = sum;
-                                }
-                            }
-                        }
-                    }
-                });
-            if let Some(lin) = self.linearised.as_deref_mut() {
-                for i in 0..len {
-                    let md = sizes[i];
-                    let eqs = &eq_buf[i * stride_eq..i * stride_eq + md];
-                    if eqs.iter().all(Option::is_some) {
-                        continue;
-                    }
-                    let nodes = table.point(start + i).0;
-                    let kl = &local[i * stride_k..];
-                    for (ri, row) in eqs.iter().enumerate() {
-                        if row.is_some() {
-                            continue;
-                        }
-                        let dof = nodes[ri / D] * D + ri % D;
-                        for (ci, col) in eqs.iter().enumerate() {
-                            if let Some(col) = *col {
-                                lin.rows.push((dof, col, kl[ci * md + ri]));
-                            }
-                        }
-                    }
-                }
-            }
-            // Runs of consecutive points with the same equations (the Gauss points of one
-            // element, material points of one cell with the same support) are scattered
-            // once, their local matrices summed in point order first: one search and one
-            // update per entry per run instead of per point.
-            groups.clear();
-            for i in 0..len {
-                let eqs = &eq_buf[i * stride_eq..i * stride_eq + sizes[i]];
-                let same = i > 0 && eqs == &eq_buf[(i - 1) * stride_eq..(i - 1) * stride_eq + sizes[i - 1]];
-                if !same {
-                    groups.push(i);
-                }
-            }
-            groups.push(len);
-            let (local, eq_buf, sizes, groups) = (&local, &eq_buf, &sizes, &groups);
-            self.matrix
-                .column_blocks(threads)
-                .into_par_iter()
-                .for_each(|mut block| {
-                    for g in groups.windows(2) {
-                        let (first, end) = (g[0], g[1]);
-                        let md = sizes[first];
-                        let eqs = &eq_buf[first * stride_eq..first * stride_eq + md];
-                        for (ci, col) in eqs.iter().enumerate() {
-                            let Some(col) = *col else { continue };
-                            if !block.owns(col) {
-                                continue;
-                            }
-                            let mut hint = usize::MAX;
-                            for (ri, row) in eqs.iter().enumerate() {
-                                if let Some(row) = *row {
-                                    let e = ci * md + ri;
-                                    let mut v = local[first * stride_k + e];
-                                    for i in first + 1..end {
-                                        v += local[i * stride_k + e];
-                                    }
-                                    block.add_with_hint(row, col, v, &mut hint);
-                                }
-                            }
-                        }
-                    }
-                });
+        let runs = &runs;
+        self.matrix
+            .column_blocks(threads)
+            .into_par_iter()
+            .for_each(|mut block| kernel.add_runs(&mut block, runs));
+        if let Some(lin) = self.linearised.as_deref_mut() {
+            kernel.linearised_rows(n, &mut lin.rows);
         }
         if let Some(g) = self.ghost {
             g.add_tangent(self.dofs, self.matrix);
@@ -468,10 +346,10 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         if let Some(i) = inertia.filter(|i| i.mass == MassMatrix::Lumped) {
             // α m_a on the diagonal, m_a = Σ_p m_p S_ap.
             for p in 0..n {
-                let (nodes, s, _) = table.point(p);
+                let (nodes, s, _) = self.table.point(p);
                 for (&node, &w) in nodes.iter().zip(s) {
                     for a in 0..D {
-                        if let Some(e) = dofs.eq(node * D + a) {
+                        if let Some(e) = self.dofs.eq(node * D + a) {
                             self.matrix
                                 .add(e, e, i.step.tangent_mass_factor() * i.point_masses[p] * w);
                         }
@@ -480,6 +358,220 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             }
         }
     }
+}
+
+/// One point's tangent block K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V (eq 27), plus
+/// the consistent mass term `mass` S_a S_b δ_ik, into `kl` column-major (column (b, k) at
+/// `(b D + k) md`, md = nodes · D), so that the scatter reads each column contiguously.
+#[inline(never)]
+fn point_block<const D: usize>(
+    gx: &[SVector<f64, D>],
+    weights: &[f64],
+    a: &nalgebra::SMatrix<f64, 9, 9>,
+    v: f64,
+    mass: f64,
+    kl: &mut [f64],
+) {
+    let md = gx.len() * D;
+    for kb in 0..gx.len() {
+        for k in 0..D {
+            let mut c = [[0.0; 3]; 3];
+            for i in 0..D {
+                for j in 0..D {
+                    let mut s = 0.0;
+                    for l in 0..D {
+                        s += a[(ij(i, j), ij(k, l))] * gx[kb][l];
+                    }
+                    c[i][j] = s * v;
+                }
+            }
+            for ka in 0..gx.len() {
+                for i in 0..D {
+                    let mut sum = 0.0;
+                    for j in 0..D {
+                        sum += gx[ka][j] * c[i][j];
+                    }
+                    if i == k && mass != 0.0 {
+                        sum += mass * weights[ka] * weights[kb];
+                    }
+                    kl[(kb * D + k) * md + ka * D + i] = sum;
+                }
+            }
+        }
+    }
+}
+
+/// Points whose runs of equal equations are cut at multiples of this count: the chunk of
+/// points whose blocks an earlier assembly buffered at once, kept so that every entry sums
+/// the same terms in the same order as before (the tangents are bit for bit those of the
+/// committed studies). Not tuned.
+const RUN_WINDOW: usize = 4096;
+
+/// Most equations one point reaches (D ≤ 3).
+const MAX_POINT_EQS: usize = MAX_POINT_NODES * 3;
+
+/// What forms a point's tangent block: the step's supports, equations, model and trial
+/// states.
+struct PointKernel<'a, const D: usize> {
+    table: &'a SupportTable<D>,
+    dofs: &'a DofMap,
+    model: &'a dyn ConstitutiveModel,
+    states: &'a [PointState],
+    trials: &'a [Option<PointTrial<D>>],
+    inertia: Option<Inertia<'a>>,
+}
+
+impl<const D: usize> PointKernel<'_, D> {
+    /// Point `p`'s equations (node by node, D each; `None`: a fixed dof) into `eqs`; returns
+    /// their count.
+    fn equations(&self, p: usize, eqs: &mut [Option<usize>; MAX_POINT_EQS]) -> usize {
+        let nodes = self.table.point(p).0;
+        for (k, node) in nodes.iter().enumerate() {
+            for a in 0..D {
+                eqs[k * D + a] = self.dofs.eq(node * D + a);
+            }
+        }
+        nodes.len() * D
+    }
+
+    /// Point `p`'s block (eq 27 and the consistent mass) into `kl`, column-major.
+    fn block(&self, p: usize, kl: &mut Vec<f64>) {
+        let t = self.trials[p].as_ref().expect("evaluated");
+        let (nodes, weights, g) = self.table.point(p);
+        let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
+        let inv_t = t.delta_f_inv.transpose();
+        for k in 0..nodes.len() {
+            gx[k] = inv_t * g[k]; // eq (36)
+        }
+        let md = nodes.len() * D;
+        kl.resize(md * md, 0.0);
+        let a = t.spatial_tangent(self.model, &self.states[p]);
+        // The inertia term's α m_p S_a S_b δ_ik (consistent mass).
+        let mass = self
+            .inertia
+            .filter(|i| i.mass == MassMatrix::Consistent)
+            .map_or(0.0, |i| i.step.tangent_mass_factor() * i.point_masses[p]);
+        point_block::<D>(&gx[..nodes.len()], weights, &a, t.volume, mass, kl);
+    }
+
+    /// The starts of the runs of consecutive points with equal equations (the Gauss points of
+    /// one element, material points of one cell with the same support), cut at multiples of
+    /// [`RUN_WINDOW`], then `n`.
+    fn runs(&self, n: usize) -> Vec<usize> {
+        let windows: Vec<usize> = (0..n).step_by(RUN_WINDOW).collect();
+        let mut runs: Vec<usize> = windows
+            .into_par_iter()
+            .flat_map_iter(|start| {
+                let mut starts = vec![];
+                let mut previous = [None; MAX_POINT_EQS];
+                let mut previous_len = usize::MAX;
+                let mut eqs = [None; MAX_POINT_EQS];
+                for p in start..(start + RUN_WINDOW).min(n) {
+                    let md = self.equations(p, &mut eqs);
+                    if md != previous_len || eqs[..md] != previous[..md] {
+                        starts.push(p);
+                    }
+                    previous[..md].copy_from_slice(&eqs[..md]);
+                    previous_len = md;
+                }
+                starts
+            })
+            .collect();
+        runs.push(n);
+        runs
+    }
+
+    /// Add every run that reaches a column of `block` into those columns: each run's point
+    /// blocks summed in point order first, then one update per entry, the run's rows found
+    /// as stretches of consecutive equations.
+    fn add_runs(&self, block: &mut crate::sparse::ColumnBlock<'_>, runs: &[usize]) {
+        let (lo, hi) = block.columns();
+        let owned = |c: &usize| (lo..hi).contains(c);
+        let mut eqs = [None; MAX_POINT_EQS];
+        let (mut sum, mut kl, mut stretches) = (Vec::new(), Vec::new(), Vec::new());
+        for w in runs.windows(2) {
+            let (first, end) = (w[0], w[1]);
+            let md = self.equations(first, &mut eqs);
+            let eqs = &eqs[..md];
+            if !eqs.iter().flatten().any(owned) {
+                continue;
+            }
+            self.block(first, &mut sum);
+            for p in first + 1..end {
+                self.block(p, &mut kl);
+                sum.iter_mut().zip(&kl).for_each(|(s, k)| *s += k);
+            }
+            row_stretches(eqs, &mut stretches);
+            for (ci, col) in eqs.iter().enumerate() {
+                let Some(col) = col.filter(owned) else { continue };
+                let column = &sum[ci * md..(ci + 1) * md];
+                let mut hint = usize::MAX;
+                for r in &stretches {
+                    let values = block.stretch_with_hint(r.row, col, r.len, &mut hint);
+                    values
+                        .iter_mut()
+                        .zip(&column[r.local..r.local + r.len])
+                        .for_each(|(x, v)| *x += v);
+                }
+            }
+        }
+    }
+
+    /// The rows of fixed dofs (their reactions, `ResidualNorm::Linearised`): (dof, column,
+    /// K entry) in point order.
+    fn linearised_rows(&self, n: usize, rows: &mut Vec<(usize, usize, f64)>) {
+        let mut eqs = [None; MAX_POINT_EQS];
+        let mut kl = Vec::new();
+        for p in 0..n {
+            let md = self.equations(p, &mut eqs);
+            let eqs = &eqs[..md];
+            if eqs.iter().all(Option::is_some) {
+                continue;
+            }
+            self.block(p, &mut kl);
+            let nodes = self.table.point(p).0;
+            for (ri, row) in eqs.iter().enumerate() {
+                if row.is_some() {
+                    continue;
+                }
+                let dof = nodes[ri / D] * D + ri % D;
+                for (ci, col) in eqs.iter().enumerate() {
+                    if let Some(col) = *col {
+                        rows.push((dof, col, kl[ci * md + ri]));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Local rows `local..local + len` whose equations are `row..row + len`.
+#[derive(Debug, Clone, Copy)]
+struct RowStretch {
+    local: usize,
+    len: usize,
+    row: usize,
+}
+
+/// A point's equations as stretches of consecutive ones (a node's D dofs, and nodes next to
+/// each other along the first axis), fixed dofs left out.
+fn row_stretches(eqs: &[Option<usize>], out: &mut Vec<RowStretch>) {
+    out.clear();
+    let mut open: Option<RowStretch> = None;
+    for (ri, eq) in eqs.iter().enumerate() {
+        match (*eq, open.as_mut()) {
+            (Some(row), Some(r)) if row == r.row + r.len => r.len += 1,
+            (eq, _) => {
+                out.extend(open.take());
+                open = eq.map(|row| RowStretch {
+                    local: ri,
+                    len: 1,
+                    row,
+                });
+            }
+        }
+    }
+    out.extend(open);
 }
 
 impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
