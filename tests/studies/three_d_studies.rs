@@ -116,7 +116,7 @@ fn compaction_3d_quick_tier_converges_quadratically_and_passes_its_checks() {
     assert!(dev.abs() < 0.01, "{dev:e}");
     // The sizes are the 3D ones: 4 x 4 x 8 cells with 8 points each, 128 Hex8 elements.
     assert_eq!(p2.points, 1024);
-    let hex8 = r.cases.iter().find(|c| c.id == "fem-hex8-elastic-h1").unwrap();
+    let hex8 = r.cases.iter().find(|c| c.id == "fem-hex8-elastic-h1-cg").unwrap();
     assert_eq!(hex8.points, 128);
 }
 
