@@ -253,16 +253,6 @@ impl ColumnBlock<'_> {
         let offset = self.col_ptr[self.first_col];
         &mut self.values[k - offset..k + len - offset]
     }
-
-    /// `K[row, col] += v` for an owned column.
-    #[inline]
-    pub fn add(&mut self, row: usize, col: usize, v: f64) {
-        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        match self.row_idx[a..b].binary_search(&row) {
-            Ok(k) => self.values[a + k - self.col_ptr[self.first_col]] += v,
-            Err(_) => panic!("entry ({row}, {col}) is not in the sparsity pattern"),
-        }
-    }
 }
 
 /// A sparse matrix in compressed sparse row form.

@@ -1,6 +1,37 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+use igimp::basis::Basis;
+use igimp::ghost::GhostSettings;
+use igimp::mpm::{DomainUpdate, Loads, MpmSettings};
+use igimp::newton::NewtonSettings;
+use nalgebra::SVector;
+
+/// The settings of the single-state checks (tangents, patches): `basis` with eq (39)'s domain
+/// update, one load step, `ghost`, and the defaults otherwise.
+pub fn single_step_settings(basis: Basis, ghost: GhostSettings) -> MpmSettings {
+    MpmSettings {
+        basis,
+        domain_update: DomainUpdate::Stretch,
+        newton: NewtonSettings::default(),
+        load_steps: 1,
+        weak_node_tolerance: 0.0,
+        weak_node_treatment: Default::default(),
+        volume_update: Default::default(),
+        linear_solver: Default::default(),
+        ghost,
+        dynamics: None,
+    }
+}
+
+/// No gravity and no point loads.
+pub fn no_loads<const D: usize>() -> Loads<D> {
+    Loads {
+        gravity: SVector::<f64, D>::zeros(),
+        point_loads: vec![],
+    }
+}
+
 /// Seeded SplitMix64: reproducible pseudo-random numbers without a dependency.
 pub struct Rng(u64);
 

@@ -2,15 +2,16 @@
 //! every material point to round-off, and nodes whose support lies inside the material carry
 //! no internal force (uniform stress is in equilibrium), for MPM and GIMP in 1D and 2D.
 
+use crate::common;
 use igimp::assembly::{DofMap, LoadStepSystem};
 use igimp::basis::Basis;
 use igimp::constitutive::LinearElastic;
 use igimp::grid::Grid;
 use igimp::linear::SparseSystem;
-use igimp::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
-use igimp::newton::{NewtonSettings, NonlinearSystem};
+use igimp::mpm::MpmSolver;
+use igimp::newton::NonlinearSystem;
 use igimp::particles::MaterialPoints;
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SMatrix;
 
 fn patch<const D: usize>(
     basis: Basis,
@@ -21,22 +22,8 @@ fn patch<const D: usize>(
 ) {
     let points = MaterialPoints::fill_box(&grid, lower, upper, [2; D], 3.0).unwrap();
     let model = LinearElastic::try_new(1e5, 0.3).unwrap();
-    let settings = MpmSettings {
-        basis,
-        domain_update: DomainUpdate::Stretch,
-        newton: NewtonSettings::default(),
-        load_steps: 1,
-        weak_node_tolerance: 0.0,
-        weak_node_treatment: Default::default(),
-        volume_update: Default::default(),
-        linear_solver: Default::default(),
-        ghost: Default::default(),
-        dynamics: None,
-    };
-    let loads = Loads {
-        gravity: SVector::<f64, D>::zeros(),
-        point_loads: vec![],
-    };
+    let settings = common::single_step_settings(basis, Default::default());
+    let loads = common::no_loads::<D>();
     let mut solver =
         MpmSolver::try_new(grid.clone(), points, Box::new(model), vec![], loads, settings).unwrap();
     solver.build_supports().unwrap();

@@ -14,8 +14,8 @@ use igimp::kinematics::{
 };
 use igimp::linear::SparseSystem;
 use igimp::load_stepping::LoadStepping;
-use igimp::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
-use igimp::newton::{NewtonSettings, NonlinearSystem};
+use igimp::mpm::MpmSolver;
+use igimp::newton::NonlinearSystem;
 use igimp::particles::MaterialPoints;
 use igimp::problems::column::ColumnSpec;
 use igimp::tensor::{contract, ij};
@@ -100,6 +100,43 @@ fn tangent_error_with<const D: usize>(
     seed: u64,
     wrong_ghost: bool,
 ) -> f64 {
+    assembled_at(solver, u0_scale, seed, wrong_ghost, |sys, u0| {
+        let n = u0.len();
+        let k: Vec<Vec<f64>> = (0..n)
+            .map(|i| (0..n).map(|j| sys.matrix.get(i, j)).collect())
+            .collect();
+        let h = 1e-6 * u0_scale.max(1e-3);
+        let mut max_err: f64 = 0.0;
+        let mut max_k: f64 = 0.0;
+        let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
+        for j in 0..n {
+            let mut up = u0.to_vec();
+            up[j] += h;
+            let mut um = u0.to_vec();
+            um[j] -= h;
+            sys.evaluate(&up, &mut rp).unwrap();
+            sys.evaluate(&um, &mut rm).unwrap();
+            for i in 0..n {
+                let fd = (rp[i] - rm[i]) / (2.0 * h);
+                max_err = max_err.max((fd - k[i][j]).abs());
+                max_k = max_k.max(k[i][j].abs());
+            }
+        }
+        max_err / max_k
+    })
+}
+
+/// The step system of `solver`'s committed state (with its ghost faces when its settings have
+/// them) evaluated at a random increment u0 of scale `u0_scale` and its tangent assembled
+/// (`wrong_ghost`: without the ghost term, which the residual keeps); `check` gets the system
+/// and u0.
+fn assembled_at<const D: usize, R>(
+    solver: &mut MpmSolver<D>,
+    u0_scale: f64,
+    seed: u64,
+    wrong_ghost: bool,
+    check: impl FnOnce(&mut LoadStepSystem<'_, D>, &[f64]) -> R,
+) -> R {
     solver.build_supports().unwrap();
     solver.build_ghost();
     let ghost = solver.settings.ghost.is_on().then(|| solver.ghost().clone());
@@ -140,27 +177,7 @@ fn tangent_error_with<const D: usize>(
     }
     sys.assemble_tangent();
     sys.ghost = ghost_ref;
-    let k: Vec<Vec<f64>> = (0..n)
-        .map(|i| (0..n).map(|j| sys.matrix.get(i, j)).collect())
-        .collect();
-    let h = 1e-6 * u0_scale.max(1e-3);
-    let mut max_err: f64 = 0.0;
-    let mut max_k: f64 = 0.0;
-    let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
-    for j in 0..n {
-        let mut up = u0.clone();
-        up[j] += h;
-        let mut um = u0.clone();
-        um[j] -= h;
-        sys.evaluate(&up, &mut rp).unwrap();
-        sys.evaluate(&um, &mut rm).unwrap();
-        for i in 0..n {
-            let fd = (rp[i] - rm[i]) / (2.0 * h);
-            max_err = max_err.max((fd - k[i][j]).abs());
-            max_k = max_k.max(k[i][j].abs());
-        }
-    }
-    max_err / max_k
+    check(&mut sys, &u0)
 }
 
 /// 1D column of every basis family after 8 load steps at W = 400,000 (F ≈ 0.85 at the base), ν = 0.3 so the
@@ -239,22 +256,8 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
             .iter()
             .flat_map(|&n| [(n, 0), (n, 1)])
             .collect();
-        let settings = MpmSettings {
-            basis,
-            domain_update: DomainUpdate::Stretch,
-            newton: NewtonSettings::default(),
-            load_steps: 1,
-            weak_node_tolerance: 0.0,
-            weak_node_treatment: Default::default(),
-            volume_update: Default::default(),
-            linear_solver: Default::default(),
-            ghost,
-            dynamics: None,
-        };
-        let loads = Loads {
-            gravity: SVector::<f64, 2>::zeros(),
-            point_loads: vec![],
-        };
+        let settings = common::single_step_settings(basis, ghost);
+        let loads = common::no_loads::<2>();
         let mut solver = MpmSolver::try_new(grid, points, Box::new(model), fixed, loads, settings).unwrap();
         let err = global_tangent_error(&mut solver, 0.05, 22);
         assert!(err < 1e-6, "{basis:?} {ghost:?}: relative tangent error {err:e}");
@@ -432,22 +435,8 @@ fn stretched_block<const D: usize>(basis: Basis, plastic: bool) -> MpmSolver<D> 
         .iter()
         .flat_map(|&n| (0..D).map(move |a| (n, a)))
         .collect();
-    let settings = MpmSettings {
-        basis,
-        domain_update: DomainUpdate::Stretch,
-        newton: NewtonSettings::default(),
-        load_steps: 1,
-        weak_node_tolerance: 0.0,
-        weak_node_treatment: Default::default(),
-        volume_update: Default::default(),
-        linear_solver: Default::default(),
-        ghost: Default::default(),
-        dynamics: None,
-    };
-    let loads = Loads {
-        gravity: SVector::<f64, D>::zeros(),
-        point_loads: vec![],
-    };
+    let settings = common::single_step_settings(basis, Default::default());
+    let loads = common::no_loads::<D>();
     MpmSolver::try_new(grid, points, model, fixed, loads, settings).unwrap()
 }
 
@@ -461,71 +450,50 @@ fn literal_kernel_error<const D: usize>(
     seed: u64,
     wrong: bool,
 ) -> f64 {
-    solver.build_supports().unwrap();
-    let table = solver.supports().clone();
-    let dofs = DofMap::build(solver.grid.num_nodes(), &table, &solver.fixed, &[]);
-    let n = dofs.len();
-    let mut matrix = SparseSystem::default();
-    matrix.set_pattern(dofs.pattern(&table));
-    let f_ext = vec![0.0; n];
-    let (mut trials, mut du) = (Vec::new(), Vec::new());
-    let mut rng = Rng::new(seed);
-    let u0: Vec<f64> = (0..n).map(|_| rng.uniform(-u0_scale, u0_scale)).collect();
-    let model = solver.model();
-    let mut sys = LoadStepSystem {
-        model,
-        states: &solver.points.state,
-        table: &table,
-        dofs: &dofs,
-        f_ext: &f_ext,
-        matrix: &mut matrix,
-        trials: &mut trials,
-        du_nodal: &mut du,
-        ghost: None,
-        fixed_forces: &mut Vec::new(),
-        linearised: None,
-        inertia: None,
-        dynamic_reference: None,
-    };
-    let mut r0 = vec![0.0; n];
-    sys.evaluate(&u0, &mut r0).unwrap();
-    sys.assemble_tangent();
-    let mut literal = vec![vec![0.0; n]; n];
-    for (p, trial) in trials.iter().enumerate() {
-        let t = trial.as_ref().unwrap();
-        let a = t.spatial_tangent(model, &solver.points.state[p]);
-        let (nodes, _, g) = table.point(p);
-        let map = if wrong {
-            SMatrix::<f64, D, D>::identity()
-        } else {
-            t.delta_f_inv.transpose()
-        };
-        let gx: Vec<SVector<f64, D>> = g.iter().map(|g| map * g).collect();
-        for (na, ga) in nodes.iter().zip(&gx) {
-            for (nb, gb) in nodes.iter().zip(&gx) {
-                for i in 0..D {
-                    for k in 0..D {
-                        let (Some(r), Some(c)) = (dofs.eq(na * D + i), dofs.eq(nb * D + k)) else {
-                            continue;
-                        };
-                        for j in 0..D {
-                            for l in 0..D {
-                                literal[r][c] += ga[j] * a[(ij(i, j), ij(k, l))] * gb[l] * t.volume;
+    assert!(
+        !solver.settings.ghost.is_on(),
+        "the literal sum leaves the ghost term out"
+    );
+    assembled_at(solver, u0_scale, seed, false, |sys, u0| {
+        let n = u0.len();
+        let mut literal = vec![vec![0.0; n]; n];
+        for (p, trial) in sys.trials.iter().enumerate() {
+            let t = trial.as_ref().unwrap();
+            let a = t.spatial_tangent(sys.model, &sys.states[p]);
+            let (nodes, _, g) = sys.table.point(p);
+            let map = if wrong {
+                SMatrix::<f64, D, D>::identity()
+            } else {
+                t.delta_f_inv.transpose()
+            };
+            let gx: Vec<SVector<f64, D>> = g.iter().map(|g| map * g).collect();
+            for (na, ga) in nodes.iter().zip(&gx) {
+                for (nb, gb) in nodes.iter().zip(&gx) {
+                    for i in 0..D {
+                        for k in 0..D {
+                            let (Some(r), Some(c)) = (sys.dofs.eq(na * D + i), sys.dofs.eq(nb * D + k))
+                            else {
+                                continue;
+                            };
+                            for j in 0..D {
+                                for l in 0..D {
+                                    literal[r][c] += ga[j] * a[(ij(i, j), ij(k, l))] * gb[l] * t.volume;
+                                }
                             }
                         }
                     }
                 }
             }
         }
-    }
-    let (mut err, mut max): (f64, f64) = (0.0, 0.0);
-    for (r, row) in literal.iter().enumerate() {
-        for (c, &v) in row.iter().enumerate() {
-            err = err.max((matrix.get(r, c) - v).abs());
-            max = max.max(v.abs());
+        let (mut err, mut max): (f64, f64) = (0.0, 0.0);
+        for (r, row) in literal.iter().enumerate() {
+            for (c, &v) in row.iter().enumerate() {
+                err = err.max((sys.matrix.get(r, c) - v).abs());
+                max = max.max(v.abs());
+            }
         }
-    }
-    err / max
+        err / max
+    })
 }
 
 /// The assembled tangent equals eq (27) summed entry by entry to round-off (1e-12 relative,
