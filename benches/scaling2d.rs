@@ -8,7 +8,9 @@
 //! residual, pattern and tangent, to measure its cost against the same run without it.
 //! `SCALING_SHIFT=<s>` translates every point by s·h in x and y first, so that the block's
 //! boundary cells are partially filled (the block starts cell-aligned: no cut faces).
-//! `SCALING_SOLVER=lu|llt|ldlt` picks the factorisation (default LDLᵀ).
+//! `SCALING_SOLVER=lu|llt|ldlt|cg` picks the factorisation (default LDLᵀ) or multigrid CG.
+//! `SCALING_REPEAT=<k>` times the constitutive pass, assembly and solve k times and reports
+//! each one's fastest (the shared machine's timings wander from run to run).
 mod scaling;
 
 use igimp::problems::compaction::CompactionSpec;

@@ -379,7 +379,7 @@ fn stencil_matrix(n: usize) -> (Csr, DofGeometry) {
                     for ii in i.saturating_sub(1)..(i + 2).min(n) {
                         for cc in 0..2 {
                             let col = 2 * (jj * n + ii) + cc;
-                            idx.push(col);
+                            idx.push(col as u32);
                             val.push(if col == 2 * (j * n + i) + c {
                                 8.0
                             } else {
@@ -393,37 +393,35 @@ fn stencil_matrix(n: usize) -> (Csr, DofGeometry) {
         }
     }
     let m = 2 * n * n;
-    let a = Csr {
-        rows: m,
-        cols: m,
-        ptr,
-        idx,
-        val,
-    };
-    (a, geometry)
+    (Csr::new(m, m, ptr, idx, val), geometry)
 }
 
 /// `A B` of row-compressed matrices by faer: the row-compressed A is the column-compressed
 /// Aᵀ, so faer's Bᵀ Aᵀ in column-compressed form is A B in row-compressed form.
 fn faer_matmul(a: &Csr, b: &Csr) -> Csr {
     use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+    // faer wants one index type for pointers and indices: the (4-byte) indices widened.
+    let (a_idx, b_idx): (Vec<usize>, Vec<usize>) = (
+        a.idx.iter().map(|&j| j as usize).collect(),
+        b.idx.iter().map(|&j| j as usize).collect(),
+    );
     let at = SparseColMatRef::new(
-        SymbolicSparseColMatRef::new_checked(a.cols, a.rows, &a.ptr, None, &a.idx),
+        SymbolicSparseColMatRef::new_checked(a.cols, a.rows, &a.ptr, None, &a_idx),
         &a.val,
     );
     let bt = SparseColMatRef::new(
-        SymbolicSparseColMatRef::new_checked(b.cols, b.rows, &b.ptr, None, &b.idx),
+        SymbolicSparseColMatRef::new_checked(b.cols, b.rows, &b.ptr, None, &b_idx),
         &b.val,
     );
     let c = faer::sparse::linalg::matmul::sparse_sparse_matmul(bt, at, 1.0, faer::Par::Seq).unwrap();
     let (sym, val) = c.parts();
-    Csr {
-        rows: a.rows,
-        cols: b.cols,
-        ptr: sym.col_ptr().to_vec(),
-        idx: sym.row_idx().to_vec(),
-        val: val.to_vec(),
-    }
+    Csr::new(
+        a.rows,
+        b.cols,
+        sym.col_ptr().to_vec(),
+        sym.row_idx().iter().map(|&i| i as u32).collect(),
+        val.to_vec(),
+    )
 }
 
 fn galerkin(c: &mut Criterion) {
