@@ -48,6 +48,11 @@ impl<const D: usize> SupportTable<D> {
     pub fn num_points(&self) -> usize {
         self.offsets.len().saturating_sub(1)
     }
+    /// Every point's nodes, flat, and where each point's start: all the sparsity pattern
+    /// reads of the table ([`DofMap::pattern`]).
+    pub fn node_lists(&self) -> (&[usize], &[usize]) {
+        (&self.offsets, &self.nodes)
+    }
     /// Nodes, weights and gradients of point `p`.
     #[inline]
     pub fn point(&self, p: usize) -> (&[usize], &[f64], &[SVector<f64, D>]) {
@@ -82,7 +87,7 @@ impl<const D: usize> SupportTable<D> {
 }
 
 /// Equation numbers of the nodal degrees of freedom: `None` for fixed or inactive ones.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct DofMap {
     eq: Vec<Option<usize>>,
     count: usize,

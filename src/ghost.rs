@@ -302,6 +302,12 @@ impl<const D: usize> GhostOperator<D> {
     pub fn num_faces(&self) -> usize {
         self.faces.len()
     }
+    /// The penalised faces' stencil nodes, face by face: all [`Self::add_pattern`] reads of
+    /// the operator.
+    pub fn face_stencils(&self) -> impl Iterator<Item = &[usize]> + '_ {
+        let m = face_nodes(D);
+        self.faces.iter().map(move |(_, nodes)| &nodes[..m])
+    }
     /// Faces between active cells that [`Self::retain_reached`] dropped at the last build.
     pub fn num_dropped_faces(&self) -> usize {
         self.dropped

@@ -187,16 +187,24 @@ pub fn spatial_tangent_eigen<const D: usize>(
             });
             let de = q * hat * q.transpose();
             let col = ij(k, l);
+            // D^alg : de for all nine rows at once, column by column of D^alg (contiguous)
+            // in the order r = ij(m, n) ascending: each row's sum takes its products in the
+            // order the row-by-row loop did, so the values are the same to the bit, and the
+            // nine rows vectorise.
+            let mut s = [0.0; 9];
+            for m in 0..3 {
+                for n in 0..3 {
+                    let e = de[(m, n)];
+                    let column = d_alg.fixed_view::<9, 1>(0, ij(m, n));
+                    for (acc, d) in s.iter_mut().zip(column.iter()) {
+                        *acc += d * e;
+                    }
+                }
+            }
             for i in 0..D {
                 for jj in 0..D {
                     let row = ij(i, jj);
-                    let mut s = 0.0;
-                    for m in 0..3 {
-                        for n in 0..3 {
-                            s += d_alg[(row, ij(m, n))] * de[(m, n)];
-                        }
-                    }
-                    a[(row, col)] = s / j
+                    a[(row, col)] = s[row] / j
                         - if jj == k && geometric_term() {
                             sigma[(i, l)]
                         } else {

@@ -142,6 +142,13 @@ impl SparseSystem {
         self.mirror = None;
     }
 
+    /// Drop the kept multigrid (the next CG solve builds one from its matrix) but keep the
+    /// pattern, its symbolic factorisations and CG's row-compressed copy: for a new system
+    /// of the same pattern whose solves must not depend on the previous system's matrix.
+    pub fn forget_preconditioner(&mut self) {
+        self.hierarchy = None;
+    }
+
     /// Choose the factorisation (kept across [`Self::set_pattern`]).
     pub fn set_solver(&mut self, solver: LinearSolver) {
         self.solver = solver;

@@ -214,6 +214,12 @@ impl ColumnBlock<'_> {
     pub fn columns(&self) -> (usize, usize) {
         (self.first_col, self.end_col)
     }
+    /// Where column `col`'s entries start in the matrix's values (the positions
+    /// [`Self::stretch_with_hint`] takes and leaves are counted from the matrix's first entry).
+    #[inline]
+    pub fn column_start(&self, col: usize) -> usize {
+        self.col_ptr[col]
+    }
     /// The values of rows `row..row + len` of an owned column, which the pattern must hold
     /// as consecutive entries (a stretch of consecutive equations a point reaches), searched
     /// forward from position `*hint`, which is left just past them. A point's stretches
