@@ -363,6 +363,10 @@ impl<const D: usize> LoadStepSystem<'_, D> {
 /// One point's tangent block K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V (eq 27), plus
 /// the consistent mass term `mass` S_a S_b δ_ik, into `kl` column-major (column (b, k) at
 /// `(b D + k) md`, md = nodes · D), so that the scatter reads each column contiguously.
+///
+/// The common node counts (a GIMP point inside one cell or across cells, 2D and 3D) are
+/// compiled with the count fixed, so that the loops over the nodes unroll; every entry is
+/// the same sum in the same order either way.
 #[inline(never)]
 fn point_block<const D: usize>(
     gx: &[SVector<f64, D>],
@@ -372,8 +376,30 @@ fn point_block<const D: usize>(
     mass: f64,
     kl: &mut [f64],
 ) {
-    let md = gx.len() * D;
-    for kb in 0..gx.len() {
+    match gx.len() {
+        4 => point_block_of::<D>(4, gx, weights, a, v, mass, kl),
+        8 => point_block_of::<D>(8, gx, weights, a, v, mass, kl),
+        9 => point_block_of::<D>(9, gx, weights, a, v, mass, kl),
+        27 => point_block_of::<D>(27, gx, weights, a, v, mass, kl),
+        m => point_block_of::<D>(m, gx, weights, a, v, mass, kl),
+    }
+}
+
+/// [`point_block`] for `m` nodes (inlined where `m` is a constant).
+#[inline(always)]
+fn point_block_of<const D: usize>(
+    m: usize,
+    gx: &[SVector<f64, D>],
+    weights: &[f64],
+    a: &nalgebra::SMatrix<f64, 9, 9>,
+    v: f64,
+    mass: f64,
+    kl: &mut [f64],
+) {
+    let (gx, weights) = (&gx[..m], &weights[..m]);
+    let md = m * D;
+    let kl = &mut kl[..md * md];
+    for kb in 0..m {
         for k in 0..D {
             let mut c = [[0.0; 3]; 3];
             for i in 0..D {
@@ -385,7 +411,8 @@ fn point_block<const D: usize>(
                     c[i][j] = s * v;
                 }
             }
-            for ka in 0..gx.len() {
+            let out = &mut kl[(kb * D + k) * md..(kb * D + k + 1) * md];
+            for ka in 0..m {
                 for i in 0..D {
                     let mut sum = 0.0;
                     for j in 0..D {
@@ -394,7 +421,7 @@ fn point_block<const D: usize>(
                     if i == k && mass != 0.0 {
                         sum += mass * weights[ka] * weights[kb];
                     }
-                    kl[(kb * D + k) * md + ka * D + i] = sum;
+                    out[ka * D + i] = sum;
                 }
             }
         }
@@ -503,29 +530,28 @@ impl<const D: usize> PointKernel<'_, D> {
                 sum.iter_mut().zip(&kl).for_each(|(s, k)| *s += k);
             }
             row_stretches(eqs, &mut stretches);
-            found.resize(stretches.len(), 0);
-            // The run's columns mostly share one row pattern (the neighbours of the run's
-            // nodes, D columns per node), so each stretch is first looked for at the offset it
-            // had in the previous column: one comparison instead of a search. A miss falls back
-            // to the forward scan or the binary search; the entry found is the same.
-            let mut previous_start: Option<usize> = None;
+            // Interior nodes' columns share one shape (the rows of their 3^D neighbours), so
+            // each stretch is first looked for at the offset from its column's start that it
+            // had in the previous column, of this run or the last one: one comparison instead
+            // of a search. A miss (a boundary node, a run of another shape) falls back to the
+            // forward scan or the binary search; the entry found is the same.
+            found.resize(stretches.len(), usize::MAX);
             for (ci, col) in eqs.iter().enumerate() {
                 let Some(col) = col.filter(owned) else { continue };
                 let column = &sum[ci * md..(ci + 1) * md];
                 let start = block.column_start(col);
                 let mut hint = usize::MAX;
-                for (r, at) in stretches.iter().zip(found.iter_mut()) {
-                    if let Some(p) = previous_start {
-                        hint = *at - p + start;
+                for (r, offset) in stretches.iter().zip(found.iter_mut()) {
+                    if *offset != usize::MAX {
+                        hint = start + *offset;
                     }
                     let values = block.stretch_with_hint(r.row, col, r.len, &mut hint);
-                    *at = hint - r.len;
+                    *offset = hint - r.len - start;
                     values
                         .iter_mut()
                         .zip(&column[r.local..r.local + r.len])
                         .for_each(|(x, v)| *x += v);
                 }
-                previous_start = Some(start);
             }
         }
     }

@@ -373,7 +373,12 @@ impl<const D: usize> PointTrial<D> {
     /// Spatial tangent a_ijkl, eq (25), at this trial state (active components only);
     /// `committed` is the state the trial was evaluated from.
     pub fn spatial_tangent(&self, model: &dyn ConstitutiveModel, committed: &PointState) -> Tensor4 {
-        let d_alg = model.tangent(&self.eps_trial(), &committed.material);
+        let eps = if model.tangent_reads_strain() {
+            self.eps_trial()
+        } else {
+            Matrix3::zeros()
+        };
+        let d_alg = model.tangent(&eps, &committed.material);
         spatial_tangent_eigen::<D>(
             &d_alg,
             &self.b_trial_eigenvalues,

@@ -76,6 +76,10 @@ impl ConstitutiveModel for LinearElastic {
         self.d
     }
 
+    fn tangent_reads_strain(&self) -> bool {
+        false
+    }
+
     fn young_modulus(&self) -> f64 {
         self.young_modulus
     }

@@ -70,6 +70,13 @@ pub trait ConstitutiveModel: Send + Sync {
     /// trial states, 648 bytes less per point) do not carry it.
     fn tangent(&self, eps_trial: &Matrix3<f64>, committed: &MaterialState) -> Tensor4;
 
+    /// Whether [`Self::tangent`] reads its trial strain. A model whose tangent is a constant
+    /// (linear elasticity) says no, and the assembly skips the trial strain's spectral
+    /// logarithm (three `ln` and a spectral product per point and tangent), passing zeros.
+    fn tangent_reads_strain(&self) -> bool {
+        true
+    }
+
     /// The elastic Young's modulus E: the stiffness scale of stabilisation terms
     /// ([`crate::ghost`]), which must not depend on the state so that they stay quadratic.
     fn young_modulus(&self) -> f64;
