@@ -195,10 +195,11 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             let t = self.trials[p].as_ref().expect("evaluated");
             let m = self.spatial_gradients(p, t, &mut gx, &mut eqs);
             let v = t.volume;
+            let sigma = t.sigma();
             let nodes = self.table.point(p).0;
             for k in 0..m {
                 for i in 0..D {
-                    let s: f64 = (0..D).map(|j| t.sigma[(i, j)] * gx[k][j]).sum();
+                    let s: f64 = (0..D).map(|j| sigma[(i, j)] * gx[k][j]).sum();
                     match eqs[k * D + i] {
                         Some(e) => f_int[e] += s * v, // eq (29)
                         None => self.fixed_forces[nodes[k] * D + i] += s * v,
@@ -985,11 +986,11 @@ impl<const D: usize> StepWorkspace<D> {
         }
     }
 
-    /// Committed states of the converged step.
-    pub fn committed_states(&self) -> impl Iterator<Item = PointState> + '_ {
-        self.trials
-            .iter()
-            .map(|t| t.as_ref().expect("converged trial").committed())
+    /// Replace each point's state (the step's start) by the converged step's.
+    pub fn commit_states(&self, states: &mut [PointState]) {
+        for (state, t) in states.iter_mut().zip(&self.trials) {
+            *state = t.as_ref().expect("converged trial").committed(state);
+        }
     }
 }
 

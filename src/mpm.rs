@@ -412,7 +412,7 @@ impl<const D: usize> MpmSolver<D> {
         let mut corners = [SVector::<f64, D>::zeros(); crate::basis::cpdi::MAX_CORNERS];
         for p in 0..self.points.len() {
             let trial = self.work.trials[p].as_ref().expect("converged trial");
-            let f = trial.committed().f;
+            let f = trial.f(&self.points.state[p]);
             let h = self.updated_half_length(p, &f);
             if let Some(a) = (0..D).find(|&a| !(h[a] > 0.0 && h[a].is_finite())) {
                 return Err(StepFailure::Kinematics {
@@ -450,7 +450,7 @@ impl<const D: usize> MpmSolver<D> {
         }
         for p in 0..self.points.len() {
             let trial = self.work.trials[p].as_ref().expect("converged trial");
-            let new_state = trial.committed();
+            let new_state = trial.committed(&self.points.state[p]);
             self.points.state[p] = new_state;
             let du = self.work.table.interpolate(p, &self.work.du_nodal);
             self.points.position[p] += du;

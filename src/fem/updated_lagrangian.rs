@@ -279,9 +279,7 @@ impl<const D: usize> UlCore<D> {
                 work.solve(input, newton)
             })
             .map_err(|f| (f, vec![]))??;
-        for (state, new) in states.iter_mut().zip(self.work.committed_states()) {
-            *state = new;
-        }
+        self.work.commit_states(states);
         self.commit_motion();
         Ok(Increment {
             newton: report,

@@ -60,7 +60,7 @@ fn patch<const D: usize>(
     let mut r = vec![0.0; dofs.len()];
     sys.evaluate(&u, &mut r).unwrap();
     let first = trials[0].as_ref().unwrap();
-    let sigma_scale = first.sigma.amax();
+    let sigma_scale = first.sigma().amax();
     assert!(sigma_scale > 1e3, "the patch must be stressed");
     for t in trials.iter().map(|t| t.as_ref().unwrap()) {
         for i in 0..D {
@@ -72,7 +72,7 @@ fn patch<const D: usize>(
             }
         }
         assert!(
-            (t.sigma - first.sigma).amax() < 1e-10 * sigma_scale,
+            (t.sigma() - first.sigma()).amax() < 1e-10 * sigma_scale,
             "{basis:?}: stress not uniform"
         );
     }

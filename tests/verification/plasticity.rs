@@ -107,7 +107,7 @@ fn von_mises_update_is_objective_under_superposed_rotation() {
         // A committed plastic state from a first increment.
         let g0 = SMatrix::<f64, 2, 2>::from_fn(|_, _| rng.uniform(-0.08, 0.08));
         let t0 = evaluate_point::<2>(&m, &state, &g0).unwrap();
-        state = t0.committed();
+        state = t0.committed(&state);
         assert_eq!(
             state.material.b_e,
             left_cauchy_green_from_strain(&state.material.eps_e)
