@@ -190,10 +190,11 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         self.fixed_forces.clear();
         self.fixed_forces.resize(self.dofs.num_dofs(), 0.0);
         let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
-        let mut eqs = [None; MAX_POINT_NODES * 3];
+        let mut eqs = [None; MAX_POINT_EQS];
         for p in 0..self.states.len() {
             let t = self.trials[p].as_ref().expect("evaluated");
-            let m = self.spatial_gradients(p, t, &mut gx, &mut eqs);
+            let m = spatial_gradients(self.table, p, t, &mut gx);
+            point_equations(self.table, self.dofs, p, &mut eqs);
             let v = t.volume;
             let sigma = t.sigma();
             let nodes = self.table.point(p).0;
@@ -234,26 +235,6 @@ impl<const D: usize> LoadStepSystem<'_, D> {
                 None => fixed[dof] += f,
             },
         );
-    }
-
-    /// ∂S/∂x_j = ∂S/∂X̃_i (ΔF⁻¹)_ij (eq 36) and the equation numbers of point `p`'s nodes.
-    #[inline]
-    fn spatial_gradients(
-        &self,
-        p: usize,
-        t: &PointTrial<D>,
-        gx: &mut [SVector<f64, D>; MAX_POINT_NODES],
-        eqs: &mut [Option<usize>; MAX_POINT_NODES * 3],
-    ) -> usize {
-        let (nodes, _, g) = self.table.point(p);
-        let inv_t = t.delta_f_inv.transpose();
-        for k in 0..nodes.len() {
-            gx[k] = inv_t * g[k];
-            for i in 0..D {
-                eqs[k * D + i] = self.dofs.eq(nodes[k] * D + i);
-            }
-        }
-        nodes.len()
     }
 
     /// The out-of-balance left at the fixed dofs by the linearised reaction update, at `u`
@@ -361,6 +342,41 @@ impl<const D: usize> LoadStepSystem<'_, D> {
     }
 }
 
+/// Point `p`'s equations, node by node, D each (`None`: a fixed dof), into `eqs`; returns
+/// their count.
+#[inline]
+fn point_equations<const D: usize>(
+    table: &SupportTable<D>,
+    dofs: &DofMap,
+    p: usize,
+    eqs: &mut [Option<usize>; MAX_POINT_EQS],
+) -> usize {
+    let nodes = table.point(p).0;
+    for (k, node) in nodes.iter().enumerate() {
+        for a in 0..D {
+            eqs[k * D + a] = dofs.eq(node * D + a);
+        }
+    }
+    nodes.len() * D
+}
+
+/// ∂S/∂x_j = ∂S/∂X̃_i (ΔF⁻¹)_ij (eq 36) of point `p`'s nodes at trial `t` into `gx`; returns
+/// the node count.
+#[inline]
+fn spatial_gradients<const D: usize>(
+    table: &SupportTable<D>,
+    p: usize,
+    t: &PointTrial<D>,
+    gx: &mut [SVector<f64, D>; MAX_POINT_NODES],
+) -> usize {
+    let g = table.point(p).2;
+    let inv_t = t.delta_f_inv.transpose();
+    for (x, gk) in gx.iter_mut().zip(g) {
+        *x = inv_t * gk;
+    }
+    g.len()
+}
+
 /// One point's tangent block K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V (eq 27), plus
 /// the consistent mass term `mass` S_a S_b δ_ik, into `kl` column-major (column (b, k) at
 /// `(b D + k) md`, md = nodes · D), so that the scatter reads each column contiguously.
@@ -450,28 +466,18 @@ struct PointKernel<'a, const D: usize> {
 }
 
 impl<const D: usize> PointKernel<'_, D> {
-    /// Point `p`'s equations (node by node, D each; `None`: a fixed dof) into `eqs`; returns
-    /// their count.
+    /// Point `p`'s equations ([`point_equations`]); returns their count.
     fn equations(&self, p: usize, eqs: &mut [Option<usize>; MAX_POINT_EQS]) -> usize {
-        let nodes = self.table.point(p).0;
-        for (k, node) in nodes.iter().enumerate() {
-            for a in 0..D {
-                eqs[k * D + a] = self.dofs.eq(node * D + a);
-            }
-        }
-        nodes.len() * D
+        point_equations(self.table, self.dofs, p, eqs)
     }
 
     /// Point `p`'s block (eq 27 and the consistent mass) into `kl`, column-major.
     fn block(&self, p: usize, kl: &mut Vec<f64>) {
         let t = self.trials[p].as_ref().expect("evaluated");
-        let (nodes, weights, g) = self.table.point(p);
+        let weights = self.table.point(p).1;
         let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
-        let inv_t = t.delta_f_inv.transpose();
-        for k in 0..nodes.len() {
-            gx[k] = inv_t * g[k]; // eq (36)
-        }
-        let md = nodes.len() * D;
+        let m = spatial_gradients(self.table, p, t, &mut gx);
+        let md = m * D;
         kl.resize(md * md, 0.0);
         let a = t.spatial_tangent(self.model, &self.states[p]);
         // The inertia term's α m_p S_a S_b δ_ik (consistent mass).
@@ -479,7 +485,7 @@ impl<const D: usize> PointKernel<'_, D> {
             .inertia
             .filter(|i| i.mass == MassMatrix::Consistent)
             .map_or(0.0, |i| i.step.tangent_mass_factor() * i.point_masses[p]);
-        point_block::<D>(&gx[..nodes.len()], weights, &a, t.volume, mass, kl);
+        point_block::<D>(&gx[..m], weights, &a, t.volume, mass, kl);
     }
 
     /// The starts of the runs of consecutive points with equal equations (the Gauss points of
@@ -843,20 +849,19 @@ impl<const D: usize> StepWorkspace<D> {
     ) -> R {
         let start = std::time::Instant::now();
         let dofs = DofMap::build(input.num_nodes, &self.table, input.fixed, input.ties);
-        let kept = self.fixed_pattern && self.matrix.nnz() > 0 && self.matrix.dim() == dofs.len();
-        // The points still touch the nodes they touched when the pattern was built.
-        let unchanged = !kept
-            && self.matrix.nnz() > 0
+        // FEM: the connectivity never changes. Material points: they still touch the nodes
+        // they touched when the pattern was built.
+        let kept = self.matrix.nnz() > 0
             && self.matrix.dim() == dofs.len()
-            && self.pattern_key.matches(&dofs, &self.table, input.ghost);
+            && (self.fixed_pattern || self.pattern_key.matches(&dofs, &self.table, input.ghost));
         if kept {
             self.matrix.clear_values();
-        } else if unchanged {
-            // As a fresh pattern would, minus the work: the step's first CG solve still builds
-            // its multigrid from the step's own tangent, so results are those of a rebuilt
-            // pattern to the bit.
-            self.matrix.clear_values();
-            self.matrix.forget_preconditioner();
+            if !self.fixed_pattern {
+                // As a fresh pattern would, minus the work: the step's first CG solve still
+                // builds its multigrid from the step's own tangent, so results are those of a
+                // rebuilt pattern to the bit. The equations' geometry is unchanged with them.
+                self.matrix.forget_preconditioner();
+            }
         } else {
             let mut columns = dofs.pattern(&self.table);
             if let Some(g) = input.ghost {
@@ -866,11 +871,11 @@ impl<const D: usize> StepWorkspace<D> {
             if !self.fixed_pattern {
                 self.pattern_key.record(&dofs, &self.table, input.ghost);
             }
-        }
-        if !kept && self.matrix.solver() == crate::linear::LinearSolver::Iterative {
-            if let Some(g) = &self.node_geometry {
-                self.matrix
-                    .set_geometry(crate::multigrid::DofGeometry::of_equations(g, &dofs));
+            if self.matrix.solver() == crate::linear::LinearSolver::Iterative {
+                if let Some(g) = &self.node_geometry {
+                    self.matrix
+                        .set_geometry(crate::multigrid::DofGeometry::of_equations(g, &dofs));
+                }
             }
         }
         crate::profile::charge(crate::profile::Phase::Setup, start);

@@ -444,10 +444,10 @@ fn transposed<I: Index>(rows: usize, cols: usize, ptr: &[usize], idx: &[I], val:
     let mut out_idx = vec![0u32; idx.len()];
     let mut out_val = vec![0.0; idx.len()];
     for i in 0..rows {
-        let i32_ = column_index(i);
+        let row = column_index(i);
         for k in ptr[i]..ptr[i + 1] {
             let j = idx[k].get();
-            out_idx[next[j]] = i32_;
+            out_idx[next[j]] = row;
             out_val[next[j]] = val[k];
             next[j] += 1;
         }

@@ -2,10 +2,12 @@
 #![allow(dead_code)]
 
 use igimp::basis::Basis;
+use igimp::constitutive::ConstitutiveModel;
 use igimp::ghost::GhostSettings;
+use igimp::kinematics::{left_cauchy_green_from_strain, log_strain, PointState};
 use igimp::mpm::{DomainUpdate, Loads, MpmSettings};
 use igimp::newton::NewtonSettings;
-use nalgebra::SVector;
+use nalgebra::{Matrix3, SVector};
 
 /// The settings of the single-state checks (tangents, patches): `basis` with eq (39)'s domain
 /// update, one load step, `ghost`, and the defaults otherwise.
@@ -29,6 +31,24 @@ pub fn no_loads<const D: usize>() -> Loads<D> {
     Loads {
         gravity: SVector::<f64, D>::zeros(),
         point_loads: vec![],
+    }
+}
+
+/// Commit every state at the homogeneous deformation F (`f`), as if a previous step had
+/// converged there elastically: F, V = det F V₀ (V₀ the volume paired with the state),
+/// ε^e = ½ ln(F Fᵀ), b^e = exp(2 ε^e) and τ of `elastic`.
+pub fn commit_stretched<'a>(
+    states: impl IntoIterator<Item = (&'a mut PointState, f64)>,
+    f: &Matrix3<f64>,
+    elastic: &dyn ConstitutiveModel,
+) {
+    let eps = log_strain(&(f * f.transpose())).unwrap();
+    for (s, volume0) in states {
+        s.f = *f;
+        s.volume = volume0 * f.determinant();
+        s.material.eps_e = eps;
+        s.material.b_e = left_cauchy_green_from_strain(&eps);
+        s.tau = elastic.update(&eps, &s.material).unwrap().tau;
     }
 }
 

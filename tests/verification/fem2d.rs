@@ -14,7 +14,6 @@ use crate::common;
 use common::Rng;
 use igimp::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
 use igimp::fem::{ElementFamily, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
-use igimp::kinematics::{left_cauchy_green_from_strain, log_strain};
 use igimp::linear::LinearSolver;
 use igimp::load_stepping::LoadStepping;
 use igimp::newton::{check_quadratic, NonlinearSystem};
@@ -346,19 +345,12 @@ fn fem2d_patch_dead_traction_gives_homogeneous_finite_stretch() {
 /// Set every Gauss point and node to the committed homogeneous state F_n (x = F_n X,
 /// V = det F_n V_0, elastic b^e = F_n F_nᵀ), as if a previous step had converged there.
 fn impose_committed_state(fem: &mut PlaneFem, f_n: &Matrix2<f64>, young: f64, nu: f64) {
-    let f = embed(f_n);
-    let eps = log_strain(&(f * f.transpose())).unwrap();
     let elastic = LinearElastic::try_new(young, nu).unwrap();
     for x in fem.mesh.nodes.iter_mut() {
         *x = f_n * *x;
     }
-    for (s, v0) in fem.gauss.state.iter_mut().zip(&fem.gauss.volume0) {
-        s.f = f;
-        s.volume = v0 * f.determinant();
-        s.material.eps_e = eps;
-        s.material.b_e = left_cauchy_green_from_strain(&eps);
-        s.tau = elastic.update(&eps, &s.material).unwrap().tau;
-    }
+    let states = fem.gauss.state.iter_mut().zip(fem.gauss.volume0.iter().copied());
+    common::commit_stretched(states, &embed(f_n), &elastic);
 }
 
 /// Assembled tangent vs central differences of the global residual

@@ -11,7 +11,6 @@
 use crate::common::Rng;
 use igimp::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
 use igimp::fem::{ElementFamily, HexElement, HexMesh, SolidFem, SolidLoads};
-use igimp::kinematics::{left_cauchy_green_from_strain, log_strain};
 use igimp::newton::NonlinearSystem;
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 
@@ -236,18 +235,12 @@ fn fem3d_patch_imposed_homogeneous_deformation_is_exact() {
 /// Set every Gauss point and node to the committed homogeneous state F_n (x = F_n X,
 /// V = det F_n V_0, elastic b^e = F_n F_nᵀ), as if a previous step had converged there.
 fn impose_committed_state(fem: &mut SolidFem, f_n: &Matrix3<f64>, young: f64, nu: f64) {
-    let eps = log_strain(&(f_n * f_n.transpose())).unwrap();
     let elastic = LinearElastic::try_new(young, nu).unwrap();
     for x in fem.mesh.nodes.iter_mut() {
         *x = f_n * *x;
     }
-    for (s, v0) in fem.gauss.state.iter_mut().zip(&fem.gauss.volume0) {
-        s.f = *f_n;
-        s.volume = v0 * f_n.determinant();
-        s.material.eps_e = eps;
-        s.material.b_e = left_cauchy_green_from_strain(&eps);
-        s.tau = elastic.update(&eps, &s.material).unwrap().tau;
-    }
+    let states = fem.gauss.state.iter_mut().zip(fem.gauss.volume0.iter().copied());
+    crate::common::commit_stretched(states, f_n, &elastic);
 }
 
 /// Assembled tangent vs central differences of the global residual: max |K − K_fd| / max |K|

@@ -9,9 +9,7 @@ use igimp::assembly::{DofMap, LoadStepSystem};
 use igimp::basis::Basis;
 use igimp::constitutive::{ConstitutiveModel, LinearElastic, MaterialState};
 use igimp::grid::Grid;
-use igimp::kinematics::{
-    dlog, evaluate_point, left_cauchy_green_from_strain, log_strain, sym_eigen, PointState,
-};
+use igimp::kinematics::{dlog, evaluate_point, log_strain, sym_eigen, PointState};
 use igimp::linear::SparseSystem;
 use igimp::load_stepping::LoadStepping;
 use igimp::mpm::MpmSolver;
@@ -242,15 +240,14 @@ fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() 
         let f2 = r * u;
         let mut f = Matrix3::identity();
         f.fixed_view_mut::<2, 2>(0, 0).copy_from(&f2);
-        let b = f * f.transpose();
-        let eps = log_strain(&b).unwrap();
-        for s in points.state.iter_mut() {
-            s.f = f;
-            s.volume *= f.determinant();
-            s.material.eps_e = eps;
-            s.material.b_e = left_cauchy_green_from_strain(&eps);
-            s.tau = model.update(&eps, &s.material).unwrap().tau;
-        }
+        common::commit_stretched(
+            points.state.iter_mut().map(|s| {
+                let v0 = s.volume;
+                (s, v0)
+            }),
+            &f,
+            &model,
+        );
         let fixed: Vec<(usize, usize)> = grid
             .boundary_nodes(1, false)
             .iter()
@@ -423,13 +420,14 @@ fn stretched_block<const D: usize>(basis: Basis, plastic: bool) -> MpmSolver<D> 
             "the committed state must be outside the surface"
         );
     }
-    for s in points.state.iter_mut() {
-        s.f = f;
-        s.volume *= f.determinant();
-        s.material.eps_e = eps;
-        s.material.b_e = left_cauchy_green_from_strain(&eps);
-        s.tau = elastic.update(&eps, &s.material).unwrap().tau;
-    }
+    common::commit_stretched(
+        points.state.iter_mut().map(|s| {
+            let v0 = s.volume;
+            (s, v0)
+        }),
+        &f,
+        &elastic,
+    );
     let fixed: Vec<(usize, usize)> = grid
         .boundary_nodes(D - 1, false)
         .iter()
