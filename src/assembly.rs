@@ -536,6 +536,10 @@ impl<const D: usize> PointKernel<'_, D> {
                 self.block(p, &mut kl);
                 sum.iter_mut().zip(&kl).for_each(|(s, k)| *s += k);
             }
+            if block.by_rows() {
+                // The lines are K's rows: the block's rows are added as columns.
+                transpose_square(&mut sum, md);
+            }
             row_stretches(eqs, &mut stretches);
             // Interior nodes' columns share one shape (the rows of their 3^D neighbours), so
             // each stretch is first looked for at the offset from its column's start that it
@@ -587,6 +591,15 @@ impl<const D: usize> PointKernel<'_, D> {
                     }
                 }
             }
+        }
+    }
+}
+
+/// Transpose the `n` × `n` column-major block `a` in place.
+fn transpose_square(a: &mut [f64], n: usize) {
+    for c in 0..n {
+        for r in c + 1..n {
+            a.swap(c * n + r, r * n + c);
         }
     }
 }
@@ -710,10 +723,10 @@ pub struct StepWorkspace<const D: usize> {
 
 /// Everything a step's sparsity pattern is a function of: the equation of every nodal dof,
 /// every point's nodes and the ghost faces' nodes. A step whose key equals the last one's has
-/// the same pattern to the entry, so the pattern, the direct solvers' symbolic analysis and
-/// CG's row-compressed copy are kept (detected, not assumed: a point that moved to another
-/// cell changes its nodes). Stored as the last build's copies, node numbers in 4 bytes (at
-/// 1e6 3D points of 8 nodes each, 32 MB).
+/// the same pattern to the entry, so the pattern and the direct solvers' symbolic analysis are
+/// kept (detected, not assumed: a point that moved to another cell changes its nodes).
+/// Stored as the last build's copies, node numbers in 4 bytes (at 1e6 3D points of 8 nodes
+/// each, 32 MB).
 #[derive(Debug, Default)]
 pub(crate) struct PatternKey {
     dofs: DofMap,

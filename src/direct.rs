@@ -40,6 +40,9 @@ pub struct DirectSolver {
     lu: Option<Lu<usize, f64>>,
     /// What the last [`Self::factorize`] computed.
     last: Option<Factorisation>,
+    /// The pattern's row indices widened to faer's index type (the matrix keeps them in 4
+    /// bytes, faer takes one type for pointers and indices), kept with the symbolic analyses.
+    rows: Vec<usize>,
 }
 
 /// `Ok` if every entry of a solution is finite, else the singular-tangent error.
@@ -51,8 +54,19 @@ pub fn finite(x: &[f64]) -> Result<(), SolverError> {
     }
 }
 
-fn pattern<'a>(a: &CscRef<'a>) -> SymbolicSparseColMatRef<'a, usize> {
-    SymbolicSparseColMatRef::new_checked(a.n, a.n, a.col_ptr, None, a.row_idx)
+/// faer's view of `a`'s pattern, with the row indices `rows` widened from it
+/// ([`widen`]).
+fn pattern<'a>(a: &CscRef<'a>, rows: &'a [usize]) -> SymbolicSparseColMatRef<'a, usize> {
+    SymbolicSparseColMatRef::new_checked(a.n, a.n, a.col_ptr, None, rows)
+}
+
+/// `a`'s row indices in `rows`, unless they are there already: the pattern is fixed until
+/// [`DirectSolver::reset`], like the symbolic analyses.
+fn widen(a: &CscRef<'_>, rows: &mut Vec<usize>) {
+    if rows.len() != a.row_idx.len() {
+        rows.clear();
+        rows.extend(a.row_idx.iter().map(|&r| r as usize));
+    }
 }
 
 impl DirectSolver {
@@ -68,7 +82,8 @@ impl DirectSolver {
 
     /// LU of `a`, the symbolic analysis cached; the factor is returned, not kept.
     pub fn lu(&mut self, a: CscRef<'_>) -> Result<Lu<usize, f64>, SolverError> {
-        let sym = pattern(&a);
+        widen(&a, &mut self.rows);
+        let sym = pattern(&a, &self.rows);
         if self.symbolic.is_none() {
             self.symbolic =
                 Some(SymbolicLu::try_new(sym).map_err(|e| SolverError::Factorisation(format!("{e:?}")))?);
@@ -130,9 +145,10 @@ impl DirectSolver {
     /// LDLᵀ or LLᵀ of the lower triangle (faer's supernodal/simplicial Cholesky with an AMD
     /// ordering), symbolic analysis cached per pattern.
     fn factorize_symmetric(&mut self, a: CscRef<'_>, kind: Factorisation) -> Result<(), SolverError> {
+        widen(&a, &mut self.rows);
         if self.symbolic_cholesky.is_none() {
             let analysed = factorize_symbolic_cholesky(
-                pattern(&a),
+                pattern(&a, &self.rows),
                 Side::Lower,
                 SymmetricOrdering::Amd,
                 Default::default(),
@@ -144,7 +160,7 @@ impl DirectSolver {
             .symbolic_cholesky
             .as_ref()
             .expect("symbolic factorisation present");
-        let mat = SparseColMatRef::new(pattern(&a), a.values);
+        let mat = SparseColMatRef::new(pattern(&a, &self.rows), a.values);
         self.factor.resize(symbolic.len_val(), 0.0);
         let par = faer::get_global_parallelism();
         let ldlt = kind == Factorisation::Ldlt;

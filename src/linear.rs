@@ -23,7 +23,7 @@ use crate::direct::{DirectSolver, Factorisation};
 use crate::error::SolverError;
 use crate::krylov::{gmres, pcg};
 use crate::multigrid::{DofGeometry, Hierarchy};
-use crate::sparse::{Csr, CsrMirror, SparseMatrix};
+use crate::sparse::{Csr, SparseMatrix};
 use serde::{Deserialize, Serialize};
 
 /// How the Newton systems are solved: one of three sparse factorisations, or the iterative
@@ -115,8 +115,6 @@ pub struct SparseSystem {
     /// The multigrid of an earlier matrix of this pattern and the CG iterations it took when
     /// fresh ([`Self::solve_cg`] reuses it).
     hierarchy: Option<(Box<Hierarchy>, usize)>,
-    /// The row-compressed copy CG multiplies with, kept per pattern ([`CsrMirror`]).
-    mirror: Option<CsrMirror>,
 }
 
 impl std::ops::Deref for SparseSystem {
@@ -139,19 +137,21 @@ impl SparseSystem {
         self.matrix.set_pattern(columns);
         self.direct.reset();
         self.hierarchy = None;
-        self.mirror = None;
     }
 
     /// Drop the kept multigrid (the next CG solve builds one from its matrix) but keep the
-    /// pattern, its symbolic factorisations and CG's row-compressed copy: for a new system
+    /// pattern and its symbolic factorisations: for a new system
     /// of the same pattern whose solves must not depend on the previous system's matrix.
     pub fn forget_preconditioner(&mut self) {
         self.hierarchy = None;
     }
 
-    /// Choose the factorisation (kept across [`Self::set_pattern`]).
+    /// Choose the factorisation (kept across [`Self::set_pattern`]). The iterative strategy
+    /// stores the matrix by rows, which CG multiplies with, the factorisations by columns
+    /// ([`SparseMatrix::set_by_rows`]); a matrix already assembled is transposed.
     pub fn set_solver(&mut self, solver: LinearSolver) {
         self.solver = solver;
+        self.matrix.set_by_rows(solver == LinearSolver::Iterative);
     }
 
     pub fn solver(&self) -> LinearSolver {
@@ -210,27 +210,11 @@ impl SparseSystem {
     /// solve is then repeated with the fresh hierarchy. Reuse changes the preconditioner, not
     /// the system: every solve still reaches its tolerance on the current matrix.
     fn solve_cg(&mut self, b: &[f64], x: &mut [f64]) -> Result<(), SolverError> {
-        let start = std::time::Instant::now();
-        if self.mirror.is_none() {
-            let a = self.matrix.csc();
-            self.mirror = CsrMirror::of_pattern(a.n, a.col_ptr, a.row_idx);
-        }
-        let mirror = match self.mirror.take() {
-            Some(mut m) => {
-                m.refresh(self.matrix.csc().values);
-                m
-            }
-            // Too many non-zeros for the kept positions: a fresh transpose.
-            None => CsrMirror {
-                csr: self.matrix.to_csr(),
-                from: vec![],
-            },
-        };
-        self.stats.charge(crate::profile::Phase::Setup, start);
-        let out = self.solve_cg_with(&mirror.csr, b, x);
-        if !mirror.from.is_empty() {
-            self.mirror = Some(mirror);
-        }
+        // Taken out for the solve so that the strategy's state can change beside it; stored
+        // by rows ([`Self::set_solver`]), it is borrowed as it is, not copied.
+        let matrix = std::mem::take(&mut self.matrix);
+        let out = self.solve_cg_with(&matrix.csr(), b, x);
+        self.matrix = matrix;
         out
     }
 
@@ -297,7 +281,7 @@ impl SparseSystem {
         let kind = self.factorisation().ok_or(SolverError::Usage(
             "factorize: a direct solver only (LDLᵀ, LLᵀ or LU)",
         ))?;
-        let out = self.direct.factorize(self.matrix.csc(), kind);
+        let out = self.direct.factorize(self.matrix.csc().transpose_as_csc(), kind);
         self.stats.factor_nnz = self.direct.factor_nnz();
         out
     }
@@ -330,7 +314,7 @@ impl SparseSystem {
     fn solve_lu(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         use faer::linalg::solvers::Solve;
         let start = std::time::Instant::now();
-        let lu = self.direct.lu(self.matrix.csc())?;
+        let lu = self.direct.lu(self.matrix.csc().transpose_as_csc())?;
         self.stats.charge(crate::profile::Phase::Setup, start);
         let start = std::time::Instant::now();
         let n = self.matrix.dim();
@@ -347,7 +331,7 @@ impl SparseSystem {
             _ => Factorisation::Ldlt,
         };
         let start = std::time::Instant::now();
-        let factored = self.direct.factorize(self.matrix.csc(), kind);
+        let factored = self.direct.factorize(self.matrix.csc().transpose_as_csc(), kind);
         self.stats.factor_nnz = self.direct.factor_nnz();
         self.stats.charge(crate::profile::Phase::Setup, start);
         factored?;

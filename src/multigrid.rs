@@ -322,7 +322,7 @@ impl Hierarchy {
             } else {
                 Factorisation::Lu
             };
-            coarse.factorize(matrix.csc(), kind)?;
+            coarse.factorize(matrix.csc().transpose_as_csc(), kind)?;
         }
         let work = levels
             .iter()

@@ -1,5 +1,5 @@
-//! Sparse matrix storage: the column-compressed matrix the tangents are assembled into
-//! ([`SparseMatrix`], with its per-thread column blocks) and the row-compressed one the
+//! Sparse matrix storage: the compressed matrix the tangents are assembled into
+//! ([`SparseMatrix`], with its per-thread blocks of lines) and the row-compressed one the
 //! Krylov solvers and the multigrid multiply with ([`Csr`]). The lowest floor of the solver
 //! layers: [`crate::direct`], [`crate::krylov`], [`crate::multigrid`] and the strategy of
 //! [`crate::linear`] build on it, and it imports none of them.
@@ -13,14 +13,18 @@ use std::sync::Arc;
 /// round-off, so any retuning must re-run the studies that use CG.
 pub const CHUNK: usize = 4096;
 
-/// A square sparse matrix in compressed sparse column form: the pattern and values the
-/// tangents are assembled into.
+/// A square sparse matrix the tangents are assembled into, compressed by columns (what the
+/// direct factorisations read) or by rows (what CG multiplies with, [`Self::set_by_rows`]).
+/// Either way it is stored as a [`Csr`]: of K itself by rows, of Kᵀ by columns. Storing by
+/// rows for CG replaces a row-compressed copy beside the column-compressed matrix (its
+/// values, indices and gather map: 16 of 32 bytes per non-zero; 0.58 GB of the
+/// 1,002,528-element Q4 reference's 36e6 non-zeros) and the gather before every solve.
+/// The inner indices are 4 bytes ([`column_index`]).
 #[derive(Debug, Default, Clone)]
 pub struct SparseMatrix {
-    n: usize,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
-    values: Vec<f64>,
+    /// K (`by_rows`) or Kᵀ: each stored row is a column of K when compressed by columns.
+    stored: Csr,
+    by_rows: bool,
 }
 
 /// A borrowed column-compressed matrix: what the direct factorisations read.
@@ -28,167 +32,185 @@ pub struct SparseMatrix {
 pub struct CscRef<'a> {
     pub n: usize,
     pub col_ptr: &'a [usize],
-    pub row_idx: &'a [usize],
+    pub row_idx: &'a [u32],
     pub values: &'a [f64],
 }
 
 impl SparseMatrix {
     /// Build the pattern from `columns[c]` = rows that may be non-zero in column `c`
-    /// (unsorted, duplicates allowed); the values are zeroed.
+    /// (unsorted, duplicates allowed); the values are zeroed. The layout
+    /// ([`Self::set_by_rows`]) is kept.
     pub fn set_pattern(&mut self, mut columns: Vec<Vec<usize>>) {
-        self.n = columns.len();
-        self.col_ptr.clear();
-        self.row_idx.clear();
-        self.col_ptr.push(0);
+        // The old pattern goes first, so that two never coexist.
+        self.stored = Csr::default();
+        let n = columns.len();
         for col in columns.iter_mut() {
             col.sort_unstable();
             col.dedup();
-            self.row_idx.extend_from_slice(col);
-            self.col_ptr.push(self.row_idx.len());
         }
-        self.values.clear();
-        self.values.resize(self.row_idx.len(), 0.0);
+        let mut ptr = vec![0usize; n + 1];
+        if self.by_rows {
+            for &r in columns.iter().flatten() {
+                ptr[r + 1] += 1;
+            }
+        } else {
+            for (c, col) in columns.iter().enumerate() {
+                ptr[c + 1] = col.len();
+            }
+        }
+        for i in 0..n {
+            ptr[i + 1] += ptr[i];
+        }
+        let nnz = ptr[n];
+        let mut idx = vec![0u32; nnz];
+        if self.by_rows {
+            // Columns in order, so each row's column indices come out ascending.
+            let mut next = ptr.clone();
+            for (c, col) in columns.iter().enumerate() {
+                let c = column_index(c);
+                for &r in col {
+                    idx[next[r]] = c;
+                    next[r] += 1;
+                }
+            }
+        } else {
+            for (c, col) in columns.iter().enumerate() {
+                for (slot, &r) in idx[ptr[c]..ptr[c + 1]].iter_mut().zip(col) {
+                    *slot = column_index(r);
+                }
+            }
+        }
+        drop(columns);
+        self.stored = Csr::new(n, n, ptr, idx, vec![0.0; nnz]);
     }
 
-    /// The matrix as faer's column-compressed view, for the factorisations of
-    /// [`crate::direct`].
-    pub fn csc(&self) -> CscRef<'_> {
-        CscRef {
-            n: self.n,
-            col_ptr: &self.col_ptr,
-            row_idx: &self.row_idx,
-            values: &self.values,
+    /// Store by rows (`true`, for CG) or by columns (`false`, the default, for the direct
+    /// factorisations); a matrix already built is transposed into the new layout, values
+    /// and all.
+    pub fn set_by_rows(&mut self, by_rows: bool) {
+        if by_rows != self.by_rows {
+            self.stored = self.stored.transpose();
+            self.by_rows = by_rows;
         }
     }
 
-    /// Split the columns into at most `parts` blocks of about equal numbers of entries, for
-    /// parallel assembly: each entry is then updated by exactly one thread.
+    /// Whether the matrix is stored by rows ([`Self::set_by_rows`]).
+    pub fn by_rows(&self) -> bool {
+        self.by_rows
+    }
+
+    /// K compressed by columns, which is Kᵀ compressed by rows: read it with
+    /// [`Csr::transpose_as_csc`] for the factorisations of [`crate::direct`]. The matrix itself
+    /// when stored by columns, else a transposed copy (what a direct fallback of CG pays, once
+    /// per solve).
+    pub fn csc(&self) -> std::borrow::Cow<'_, Csr> {
+        if self.by_rows {
+            std::borrow::Cow::Owned(self.stored.transpose())
+        } else {
+            std::borrow::Cow::Borrowed(&self.stored)
+        }
+    }
+
+    /// The matrix row-compressed, for CG: itself when stored by rows, else a transposed
+    /// copy.
+    pub fn csr(&self) -> std::borrow::Cow<'_, Csr> {
+        if self.by_rows {
+            std::borrow::Cow::Borrowed(&self.stored)
+        } else {
+            std::borrow::Cow::Owned(self.stored.transpose())
+        }
+    }
+
+    /// Split the stored lines (columns, or rows when stored by rows) into at most `parts`
+    /// blocks of about equal numbers of entries, for parallel assembly: each entry is then
+    /// updated by exactly one thread.
     pub fn column_blocks(&mut self, parts: usize) -> Vec<ColumnBlock<'_>> {
-        let parts = parts.max(1).min(self.n.max(1));
-        let nnz = self.row_idx.len();
+        let n = self.stored.rows;
+        let parts = parts.max(1).min(n.max(1));
+        let ptr: &[usize] = &self.stored.ptr;
+        let nnz = self.stored.idx.len();
         let mut bounds = vec![0];
         for k in 1..parts {
             let target = nnz * k / parts;
-            let c = self.col_ptr.partition_point(|&p| p < target).min(self.n);
+            let c = ptr.partition_point(|&p| p < target).min(n);
             if c > *bounds.last().unwrap() {
                 bounds.push(c);
             }
         }
-        bounds.push(self.n);
+        bounds.push(n);
         let mut blocks = Vec::with_capacity(bounds.len() - 1);
-        let mut rest: &mut [f64] = &mut self.values;
+        let mut rest: &mut [f64] = &mut self.stored.val;
         for w in bounds.windows(2) {
-            let len = self.col_ptr[w[1]] - self.col_ptr[w[0]];
+            let len = ptr[w[1]] - ptr[w[0]];
             let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
             rest = tail;
             blocks.push(ColumnBlock {
                 first_col: w[0],
                 end_col: w[1],
-                col_ptr: &self.col_ptr,
-                row_idx: &self.row_idx,
+                by_rows: self.by_rows,
+                col_ptr: ptr,
+                row_idx: &self.stored.idx,
                 values: head,
             });
         }
         blocks
     }
     pub fn dim(&self) -> usize {
-        self.n
+        self.stored.rows
     }
     pub fn nnz(&self) -> usize {
-        self.row_idx.len()
+        self.stored.idx.len()
     }
     /// Zero the values, keeping the pattern.
     pub fn clear_values(&mut self) {
-        self.values.iter_mut().for_each(|v| *v = 0.0);
+        self.stored.val.iter_mut().for_each(|v| *v = 0.0);
+    }
+    /// (stored line, index within it) of K's `(row, col)`.
+    #[inline]
+    fn line(&self, row: usize, col: usize) -> (usize, usize) {
+        if self.by_rows {
+            (row, col)
+        } else {
+            (col, row)
+        }
+    }
+    /// Position of `(row, col)` in the value array, if the pattern holds it.
+    #[inline]
+    fn find(&self, row: usize, col: usize) -> Option<usize> {
+        let (line, inner) = self.line(row, col);
+        let (a, b) = (self.stored.ptr[line], self.stored.ptr[line + 1]);
+        let inner = u32::try_from(inner).ok()?;
+        self.stored.idx[a..b].binary_search(&inner).ok().map(|k| a + k)
     }
     /// Position of `(row, col)` in the value array. Panics if it is not in the pattern,
     /// which would be a bug in pattern construction, not a user error.
     #[inline]
     pub fn position(&self, row: usize, col: usize) -> usize {
-        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        match self.row_idx[a..b].binary_search(&row) {
-            Ok(k) => a + k,
-            Err(_) => panic!("entry ({row}, {col}) is not in the sparsity pattern"),
-        }
+        self.find(row, col)
+            .unwrap_or_else(|| panic!("entry ({row}, {col}) is not in the sparsity pattern"))
     }
     /// `K[row, col] += v`.
     #[inline]
     pub fn add(&mut self, row: usize, col: usize, v: f64) {
         let k = self.position(row, col);
-        self.values[k] += v;
+        self.stored.val[k] += v;
     }
     /// Value at `(row, col)`, zero outside the pattern.
     pub fn get(&self, row: usize, col: usize) -> f64 {
-        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        match self.row_idx[a..b].binary_search(&row) {
-            Ok(k) => self.values[a + k],
-            Err(_) => 0.0,
-        }
+        self.find(row, col).map_or(0.0, |k| self.stored.val[k])
     }
     /// `y = K x`.
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        if self.by_rows {
+            return self.stored.mul_vec(x, y);
+        }
+        let s = &self.stored;
         y.iter_mut().for_each(|v| *v = 0.0);
-        for (c, xc) in x.iter().enumerate().take(self.n) {
-            for k in self.col_ptr[c]..self.col_ptr[c + 1] {
-                y[self.row_idx[k]] += self.values[k] * xc;
+        for (c, xc) in x.iter().enumerate().take(s.rows) {
+            for k in s.ptr[c]..s.ptr[c + 1] {
+                y[s.idx[k] as usize] += s.val[k] * xc;
             }
         }
-    }
-    /// The pattern and values as a row-compressed matrix (the transpose of the stored
-    /// column-compressed one).
-    pub fn to_csr(&self) -> Csr {
-        Csr::from_csc(self.n, &self.col_ptr, &self.row_idx, &self.values)
-    }
-}
-
-/// The row-compressed copy of a column-compressed matrix, kept per pattern: its structure and
-/// where each entry sits in the column-compressed values (`from`) are built once, and each
-/// solve only gathers the current values, in parallel, into the same arrays: no transpose
-/// and no allocation of a matrix-sized buffer per solve (at 2e6 unknowns, 36e6 non-zeros:
-/// 0.6 s and 577 MB a solve before).
-#[derive(Debug)]
-pub(crate) struct CsrMirror {
-    pub(crate) csr: Csr,
-    pub(crate) from: Vec<u32>,
-}
-
-impl CsrMirror {
-    /// The mirror of an `n` × `n` pattern, or `None` if it has 2³² or more non-zeros.
-    pub(crate) fn of_pattern(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Option<Self> {
-        let nnz = row_idx.len();
-        u32::try_from(nnz).ok()?;
-        let mut ptr = vec![0usize; n + 1];
-        for &r in row_idx {
-            ptr[r + 1] += 1;
-        }
-        for i in 0..n {
-            ptr[i + 1] += ptr[i];
-        }
-        let mut next = ptr.clone();
-        let mut idx = vec![0u32; nnz];
-        let mut from = vec![0u32; nnz];
-        // Columns in order, so each row's column indices come out sorted.
-        for c in 0..n {
-            let c32 = column_index(c);
-            for k in col_ptr[c]..col_ptr[c + 1] {
-                let r = row_idx[k];
-                idx[next[r]] = c32;
-                from[next[r]] = k as u32;
-                next[r] += 1;
-            }
-        }
-        let csr = Csr::new(n, n, ptr, idx, vec![0.0; nnz]);
-        Some(CsrMirror { csr, from })
-    }
-
-    /// Gather the current values.
-    pub(crate) fn refresh(&mut self, values: &[f64]) {
-        use rayon::prelude::*;
-        self.csr
-            .val
-            .par_iter_mut()
-            .zip(self.from.par_iter())
-            .for_each(|(v, &k)| *v = values[k as usize]);
     }
 }
 
@@ -197,13 +219,15 @@ impl CsrMirror {
 /// Not tuned.
 const FORWARD_SCAN: usize = 32;
 
-/// A contiguous range of columns of a [`SparseMatrix`] whose values one thread may update
-/// while other threads update other blocks.
+/// A contiguous range of the stored lines of a [`SparseMatrix`] (columns, or rows when it
+/// is stored by rows) whose values one thread may update while other threads update other
+/// blocks. The names below say columns and rows for the column layout; by rows, they swap.
 pub struct ColumnBlock<'a> {
     first_col: usize,
     end_col: usize,
+    by_rows: bool,
     col_ptr: &'a [usize],
-    row_idx: &'a [usize],
+    row_idx: &'a [u32],
     /// Values of columns `first_col..end_col`, starting at `col_ptr[first_col]`.
     values: &'a mut [f64],
 }
@@ -213,6 +237,11 @@ impl ColumnBlock<'_> {
     #[inline]
     pub fn columns(&self) -> (usize, usize) {
         (self.first_col, self.end_col)
+    }
+    /// Whether the lines are K's rows: a dense block is then added transposed.
+    #[inline]
+    pub fn by_rows(&self) -> bool {
+        self.by_rows
     }
     /// Where column `col`'s entries start in the matrix's values (the positions
     /// [`Self::stretch_with_hint`] takes and leaves are counted from the matrix's first entry).
@@ -230,24 +259,25 @@ impl ColumnBlock<'_> {
     #[inline]
     pub fn stretch_with_hint(&mut self, row: usize, col: usize, len: usize, hint: &mut usize) -> &mut [f64] {
         let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        let row32 = column_index(row);
         let mut k = *hint;
-        let found = if k >= a && k < b && self.row_idx[k] <= row {
+        let found = if k >= a && k < b && self.row_idx[k] <= row32 {
             let stop = (k + FORWARD_SCAN).min(b);
-            while k < stop && self.row_idx[k] < row {
+            while k < stop && self.row_idx[k] < row32 {
                 k += 1;
             }
-            k < b && self.row_idx[k] == row
+            k < b && self.row_idx[k] == row32
         } else {
             false
         };
         if !found {
-            k = match self.row_idx[a..b].binary_search(&row) {
+            k = match self.row_idx[a..b].binary_search(&row32) {
                 Ok(k) => a + k,
                 Err(_) => panic!("entry ({row}, {col}) is not in the sparsity pattern"),
             };
         }
         assert!(
-            k + len <= b && self.row_idx[k + len - 1] == row + len - 1,
+            k + len <= b && self.row_idx[k + len - 1] as usize == row + len - 1,
             "rows {row}..{} of column {col} are not all in the sparsity pattern",
             row + len
         );
@@ -257,9 +287,10 @@ impl ColumnBlock<'_> {
     }
 }
 
-/// A column index of a [`Csr`]: 4 bytes, not 8, since the matrix–vector products that
-/// dominate a CG solve stream the indices beside the values (12 bytes per non-zero instead
-/// of 16; the 3D 1e6-point tangent has 31e6 non-zeros).
+/// A column index of a [`Csr`] (and a row index of a [`SparseMatrix`] stored by columns): 4
+/// bytes, not 8, since the matrix–vector products that dominate a CG solve stream the
+/// indices beside the values (12 bytes per non-zero instead of 16; the 3D 1e6-point tangent
+/// has 31e6 non-zeros).
 fn column_index(c: usize) -> u32 {
     u32::try_from(c).expect("a row-compressed matrix has fewer than 2^32 columns")
 }
@@ -348,6 +379,21 @@ impl Csr {
                     .map_or(0.0, |j| self.val[j])
             })
             .collect()
+    }
+
+    /// Aᵀ column-compressed: the same arrays read the other way, for the direct
+    /// factorisations ([`SparseMatrix::csc`] stores K by columns as Kᵀ by rows).
+    pub fn transpose_as_csc(&self) -> CscRef<'_> {
+        assert_eq!(
+            self.rows, self.cols,
+            "a column-compressed view of a square matrix"
+        );
+        CscRef {
+            n: self.rows,
+            col_ptr: &self.ptr,
+            row_idx: &self.idx,
+            values: &self.val,
+        }
     }
 
     pub fn transpose(&self) -> Csr {
@@ -453,4 +499,76 @@ fn transposed<I: Index>(rows: usize, cols: usize, ptr: &[usize], idx: &[I], val:
         }
     }
     Csr::new(cols, rows, out_ptr, out_idx, out_val)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A non-symmetric 5 × 5 matrix (structurally non-symmetric too) assembled into both
+    /// layouts, in parallel blocks as the tangent kernel does and by single adds: every
+    /// entry, product and compressed view agrees, and converting a filled matrix from one
+    /// layout to the other keeps its values. A block kernel that forgot to transpose its
+    /// dense block for the row layout fails the `get` comparison.
+    #[test]
+    fn both_layouts_hold_the_same_matrix() {
+        let entries = [
+            (0, 0, 4.0),
+            (1, 0, -1.0),
+            (0, 2, 2.5),
+            (3, 1, 7.0),
+            (4, 4, 1.0),
+            (2, 3, -3.0),
+        ];
+        let mut columns = vec![Vec::new(); 5];
+        for &(r, c, _) in &entries {
+            columns[c].push(r);
+            columns[c].push(r);
+        }
+        let build = |by_rows: bool| {
+            let mut m = SparseMatrix::default();
+            m.set_by_rows(by_rows);
+            m.set_pattern(columns.clone());
+            for block in m.column_blocks(2) {
+                let mut block = block;
+                let (lo, hi) = block.columns();
+                for &(r, c, v) in &entries {
+                    let (line, inner) = if block.by_rows() { (r, c) } else { (c, r) };
+                    if (lo..hi).contains(&line) {
+                        let start = block.column_start(line);
+                        let mut hint = start;
+                        block.stretch_with_hint(inner, line, 1, &mut hint)[0] += v;
+                    }
+                }
+            }
+            m.add(4, 4, 0.5);
+            m
+        };
+        let (cols, rows) = (build(false), build(true));
+        assert!(!cols.by_rows() && rows.by_rows());
+        for m in [&cols, &rows] {
+            assert_eq!(m.nnz(), entries.len());
+            for &(r, c, v) in &entries {
+                let expected = if (r, c) == (4, 4) { v + 0.5 } else { v };
+                assert_eq!(m.get(r, c), expected, "({r}, {c})");
+                assert_eq!(
+                    m.get(c, r) != 0.0,
+                    r == c || entries.iter().any(|e| (e.0, e.1) == (c, r))
+                );
+            }
+        }
+        let x = [1.0, -2.0, 0.5, 3.0, 0.25];
+        let (mut y1, mut y2, mut y3) = ([0.0; 5], [0.0; 5], [0.0; 5]);
+        cols.mul_vec(&x, &mut y1);
+        rows.mul_vec(&x, &mut y2);
+        rows.csr().mul_vec(&x, &mut y3);
+        assert_eq!(y1, y2);
+        assert_eq!(y1, y3);
+        assert_eq!(*cols.csr(), *rows.csr());
+        assert_eq!(*cols.csc(), *rows.csc());
+        let mut converted = rows.clone();
+        converted.set_by_rows(false);
+        assert_eq!(*converted.csc(), *cols.csc());
+        assert!(!converted.by_rows());
+    }
 }

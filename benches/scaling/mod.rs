@@ -82,12 +82,13 @@ pub fn time_iteration<const D: usize>(
     let t = Instant::now();
     let dofs = DofMap::build(solver_mpm.grid.num_nodes(), table, &solver_mpm.fixed, &[]);
     let mut matrix = SparseSystem::default();
+    // The solver first: it chooses the layout the pattern is built in.
+    matrix.set_solver(solver);
     let mut columns = dofs.pattern(table);
     if let Some(g) = ghost {
         g.add_pattern(&dofs, &mut columns);
     }
     matrix.set_pattern(columns);
-    matrix.set_solver(solver);
     if solver == LinearSolver::Iterative {
         let nodes = igimp::multigrid::NodeGeometry::of_grid(&solver_mpm.grid);
         matrix.set_geometry(igimp::multigrid::DofGeometry::of_equations(&nodes, &dofs));

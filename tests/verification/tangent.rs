@@ -142,6 +142,8 @@ fn assembled_at<const D: usize, R>(
     let dofs = DofMap::build(solver.grid.num_nodes(), &table, &solver.fixed, &[]);
     let n = dofs.len();
     let mut matrix = SparseSystem::default();
+    // The solver's layout: by rows for CG, by columns for the factorisations.
+    matrix.set_solver(solver.settings.linear_solver);
     let mut columns = dofs.pattern(&table);
     if let Some(g) = &ghost {
         g.add_pattern(&dofs, &mut columns);
@@ -387,15 +389,26 @@ fn stress_update_is_objective_under_oblique_rotation_3d() {
 /// the last axis.
 fn stretched_block<const D: usize>(basis: Basis, plastic: bool) -> MpmSolver<D> {
     use igimp::constitutive::VonMises;
+    let model: Box<dyn ConstitutiveModel> = if plastic {
+        Box::new(VonMises::try_new(1e5, 0.3, 2e3).unwrap())
+    } else {
+        Box::new(LinearElastic::try_new(1e5, 0.3).unwrap())
+    };
+    stretched_block_of(basis, plastic, model)
+}
+
+/// [`stretched_block`] with a given model (`plastic`: the committed state is checked to lie
+/// outside the von Mises surface of the block's yield stress).
+fn stretched_block_of<const D: usize>(
+    basis: Basis,
+    plastic: bool,
+    model: Box<dyn ConstitutiveModel>,
+) -> MpmSolver<D> {
+    use igimp::constitutive::VonMises;
     use nalgebra::{Rotation3, Unit, Vector3};
     let grid = Grid::try_new([0.0; D], [1.0; D], [4; D]).unwrap();
     let mut points = MaterialPoints::fill_box(&grid, [1.0; D], [3.0; D], [2; D], 10.0).unwrap();
     let elastic = LinearElastic::try_new(1e5, 0.3).unwrap();
-    let model: Box<dyn ConstitutiveModel> = if plastic {
-        Box::new(VonMises::try_new(1e5, 0.3, 2e3).unwrap())
-    } else {
-        Box::new(elastic)
-    };
     let axis = if D == 3 {
         Vector3::new(1.0, 2.0, 3.0)
     } else {
@@ -511,5 +524,84 @@ fn assembled_tangent_equals_the_literal_kernel_every_family_2d_3d_elastic_plasti
         }
         let wrong = literal_kernel_error(&mut stretched_block::<3>(basis, true), 0.05, 25, true);
         assert!(wrong > 1e-3, "{basis:?}: eq (36) left out passes ({wrong:e})");
+    }
+}
+
+/// Linear elasticity with a skew part added to its tangent: a stand-in for a model whose
+/// tangent lacks major symmetry (non-associative flow), so that the assembled K is not
+/// symmetric. Hencky elasticity and associative von Mises plasticity give symmetric tangents,
+/// on which a block added by rows without its transpose would go unnoticed.
+struct Skewed(LinearElastic);
+
+impl ConstitutiveModel for Skewed {
+    fn update(
+        &self,
+        eps_trial: &Matrix3<f64>,
+        committed: &MaterialState,
+    ) -> Result<igimp::constitutive::MaterialResponse, igimp::constitutive::MaterialError> {
+        self.0.update(eps_trial, committed)
+    }
+    fn tangent(&self, eps_trial: &Matrix3<f64>, committed: &MaterialState) -> igimp::tensor::Tensor4 {
+        let mut d = self.0.tangent(eps_trial, committed);
+        let e = self.0.young_modulus();
+        for (i, j, v) in [(0, 4, 0.3), (1, 8, -0.2), (3, 5, 0.1)] {
+            d[(i, j)] += v * e;
+            d[(j, i)] -= v * e;
+        }
+        d
+    }
+    fn young_modulus(&self) -> f64 {
+        self.0.young_modulus()
+    }
+}
+
+/// The tangent assembled by rows (CG's layout) equals the one assembled by columns (the
+/// direct factorisations') entry for entry and to the bit, for every family in 3D with ghost
+/// faces, von Mises with a plastic trial state and a model with a non-symmetric tangent
+/// ([`Skewed`]): each entry sums the same terms in the same order. The second's K is far from
+/// symmetric, so a dense block added by rows untransposed would fail.
+#[test]
+fn tangent_by_rows_equals_tangent_by_columns_to_the_bit() {
+    use igimp::ghost::{GhostFaces, GhostSettings};
+    use igimp::linear::LinearSolver;
+    let dense = |solver: &mut MpmSolver<3>| {
+        assembled_at(solver, 0.05, 26, false, |sys, u0| {
+            let n = u0.len();
+            (0..n * n)
+                .map(|k| sys.matrix.get(k / n, k % n))
+                .collect::<Vec<f64>>()
+        })
+    };
+    for basis in Basis::ALL {
+        let skewed = Box::new(Skewed(LinearElastic::try_new(1e5, 0.3).unwrap()));
+        for (symmetric, mut solver) in [
+            (true, stretched_block::<3>(basis, true)),
+            (false, stretched_block_of::<3>(basis, false, skewed)),
+        ] {
+            solver.settings.ghost = GhostSettings {
+                gamma: 0.5,
+                faces: GhostFaces::All,
+                ..Default::default()
+            };
+            let by_columns = dense(&mut solver);
+            solver.settings.linear_solver = LinearSolver::Iterative;
+            let by_rows = dense(&mut solver);
+            let n = (by_rows.len() as f64).sqrt() as usize;
+            let max = by_columns.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let asym = (0..n * n).fold(0.0f64, |m, k| {
+                m.max((by_columns[k] - by_columns[(k % n) * n + k / n]).abs())
+            });
+            assert_eq!(
+                asym < 1e-12 * max,
+                symmetric,
+                "{basis:?}: asymmetry {asym:e} of {max:e}"
+            );
+            let differ = by_rows
+                .iter()
+                .zip(&by_columns)
+                .filter(|(a, b)| a.to_bits() != b.to_bits())
+                .count();
+            assert_eq!(differ, 0, "{basis:?}: {differ} of {} entries differ", n * n);
+        }
     }
 }
