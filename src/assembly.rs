@@ -541,17 +541,26 @@ impl<const D: usize> PointKernel<'_, D> {
                 transpose_square(&mut sum, md);
             }
             row_stretches(eqs, &mut stretches);
-            // Interior nodes' columns share one shape (the rows of their 3^D neighbours), so
-            // each stretch is first looked for at the offset from its column's start that it
-            // had in the previous column, of this run or the last one: one comparison instead
-            // of a search. A miss (a boundary node, a run of another shape) falls back to the
-            // forward scan or the binary search; the entry found is the same.
-            found.resize(stretches.len(), usize::MAX);
+            // Interior nodes' columns share one shape (the rows of their 3^D neighbours), and
+            // a stretch's offset from its column's start depends on where the column's node
+            // sits among the point's nodes (a cell's lower corner finds the cell's rows above
+            // itself, the upper corner below). So each stretch is first looked for at the
+            // offset it had in the last column of the same local node, of this run or an
+            // earlier one: one comparison instead of a search (with one offset for all columns,
+            // the misses' binary searches took 5 % of a one-thread 3D assembly; 3D compaction at
+            // h = 1/7, fastest of 8: 0.68-0.72 -> 0.61 s). A miss (a boundary node, a run of another shape) falls back to the forward scan or
+            // the binary search; the entry found is the same.
+            let per_node = stretches.len();
+            if found.len() < per_node * (md / D) {
+                found.resize(per_node * (md / D), usize::MAX);
+            }
             for (ci, col) in eqs.iter().enumerate() {
                 let Some(col) = col.filter(owned) else { continue };
                 let column = &sum[ci * md..(ci + 1) * md];
                 let start = block.column_start(col);
                 let mut hint = usize::MAX;
+                let node = ci / D;
+                let found = &mut found[node * per_node..(node + 1) * per_node];
                 for (r, offset) in stretches.iter().zip(found.iter_mut()) {
                     if *offset != usize::MAX {
                         hint = start + *offset;

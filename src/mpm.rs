@@ -211,6 +211,22 @@ impl<const D: usize> MpmSolver<D> {
         })
     }
 
+    /// Renumber the material points cell by cell ([`MaterialPoints::sort_by_cell`]) and the
+    /// point loads with them, between steps. The assembly then adds a cell's points as one
+    /// run; results change at round-off only (sums over points in another order). Returns
+    /// the permutation: new point `k` is old point `order[k]`.
+    pub fn sort_points_by_cell(&mut self) -> Vec<usize> {
+        let order = self.points.sort_by_cell(&self.grid);
+        let mut new_index = vec![0; order.len()];
+        for (k, &p) in order.iter().enumerate() {
+            new_index[p] = k;
+        }
+        for (p, _) in self.loads.point_loads.iter_mut() {
+            *p = new_index[*p];
+        }
+        order
+    }
+
     /// Load the points with a body force per unit reference volume b₀(X, t) besides `loads`:
     /// b₀(X_p, t) V_p0 on each point, t the end time of each step (the load factor in a
     /// quasi-static analysis).

@@ -163,7 +163,8 @@ impl SparseMatrix {
     }
     /// Zero the values, keeping the pattern.
     pub fn clear_values(&mut self) {
-        self.stored.val.iter_mut().for_each(|v| *v = 0.0);
+        // In parallel: 250 MB at 3D's 31e6 non-zeros.
+        self.stored.val.par_chunks_mut(CHUNK).for_each(|c| c.fill(0.0));
     }
     /// (stored line, index within it) of K's `(row, col)`.
     #[inline]
