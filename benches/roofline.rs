@@ -1,7 +1,8 @@
 //! The roofline of the tangent assembly: the machine's memory bandwidth (a STREAM triad) and
 //! peak FMA rate, and the assembly's achieved flop/s and bytes/s against them.
 //!
-//! `cargo bench --bench roofline -- [2d|3d] [points]` (default: both, 1e5 points each). Prints
+//! `cargo bench --bench roofline -- [2d|3d] [points]` (default: both, 1e5 points each;
+//! `ROOFLINE_ORDER=cells` numbers the points cell by cell, `MpmSolver::sort_points_by_cell`). Prints
 //! the triad bandwidth (best of 10 over three 256 MiB arrays, 24 bytes per element as STREAM
 //! counts them), the FMA peak of the hardware (AVX2 + FMA, 4 lanes, 10 independent chains per
 //! thread, when the CPU has them) and of the build's own target (two-lane SSE2 multiply + add:
@@ -111,6 +112,12 @@ struct Assembly {
 
 /// [`Assembly`] of the solver's first step at a small increment.
 fn assembly<const D: usize>(mut solver: MpmSolver<D>) -> Assembly {
+    // `ROOFLINE_ORDER=cells`: the points renumbered cell by cell, so that a cell's points
+    // are added as one run (the byte count follows the runs); default: the row-by-row
+    // lattice of the studies.
+    if std::env::var("ROOFLINE_ORDER").as_deref() == Ok("cells") {
+        solver.sort_points_by_cell();
+    }
     let load = 1.0 / solver.load_steps() as f64;
     solver
         .with_step_system(load, |sys| {

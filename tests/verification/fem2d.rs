@@ -1,4 +1,4 @@
-//! Plane-strain updated-Lagrangian FEM comparator (issues 7 and 8): Q4 and Q8 elements, patch
+//! Plane-strain updated-Lagrangian FEM comparator: Q4 and Q8 elements, patch
 //! tests for homogeneous finite deformation, the global tangent against central differences,
 //! Newton's quadratic convergence, the Q8 cantilever against Timoshenko beam theory, the
 //! symmetric factorisation against LU, and input validation.
