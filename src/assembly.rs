@@ -546,10 +546,11 @@ impl<const D: usize> PointKernel<'_, D> {
             // sits among the point's nodes (a cell's lower corner finds the cell's rows above
             // itself, the upper corner below). So each stretch is first looked for at the
             // offset it had in the last column of the same local node, of this run or an
-            // earlier one: one comparison instead of a search (with one offset for all columns,
-            // the misses' binary searches took 5 % of a one-thread 3D assembly; 3D compaction at
-            // h = 1/7, fastest of 8: 0.68-0.72 -> 0.61 s). A miss (a boundary node, a run of another shape) falls back to the forward scan or
-            // the binary search; the entry found is the same.
+            // earlier one: one comparison instead of a search (with one offset for all
+            // columns, the misses' binary searches took 5 % of a one-thread 3D assembly; 3D
+            // compaction at h = 1/7, fastest of 8: 0.68-0.72 -> 0.61 s). A miss (a boundary
+            // node, a run of another shape) falls back to the forward scan or the binary
+            // search; the entry found is the same.
             let per_node = stretches.len();
             if found.len() < per_node * (md / D) {
                 found.resize(per_node * (md / D), usize::MAX);

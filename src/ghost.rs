@@ -42,7 +42,7 @@
 //! active cells, which also controls the odd–even (1D) and hourglass (2D) modes of one point
 //! per cell.
 
-use crate::basis::BasisFamily;
+use crate::basis::{BasisFamily, GridAxis};
 use crate::dofs::DofMap;
 use crate::error::InputError;
 use crate::grid::Grid;
@@ -185,6 +185,7 @@ pub fn cell_fill<const D: usize>(
     fill: &mut Vec<f64>,
 ) {
     let (o, h, c) = (grid.origin(), grid.spacing(), grid.cells());
+    let axes: [GridAxis; D] = std::array::from_fn(|a| GridAxis::of(grid, a));
     let cell_volume: f64 = h.iter().product();
     fill.clear();
     fill.resize(grid.num_cells(), 0.0);
@@ -203,8 +204,7 @@ pub fn cell_fill<const D: usize>(
             let n = c[a];
             let (lo, hi) = match boxed {
                 None => {
-                    let t = (x[a] - o[a]) / h[a];
-                    let e = (t.floor().max(0.0) as usize).min(n - 1);
+                    let e = axes[a].cell_of(x[a]);
                     (e as f64 + 0.5, e as f64 + 0.5)
                 }
                 Some((b_lo, b_hi)) => (

@@ -30,7 +30,7 @@ impl AxisKernel for LinearKernel {
         if !(x >= origin - 1e-12 * h && x <= upper + 1e-12 * h) {
             return Err(BasisError::OutsideGrid { axis });
         }
-        let e = (((x - origin) / h).floor().max(0.0) as usize).min(cells - 1);
+        let e = grid_axis.cell_of(x);
         let xi = 2.0 * (x - origin - (e as f64 + 0.5) * h) / h;
         out.first = e;
         out.len = 2;

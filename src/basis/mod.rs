@@ -102,6 +102,13 @@ impl GridAxis {
             cells: grid.cells()[a],
         }
     }
+
+    /// The element holding coordinate `x`, clamped to the grid (a point on the outer face
+    /// belongs to the last element; a non-finite `x` to an end element).
+    #[inline]
+    pub fn cell_of(&self, x: f64) -> usize {
+        (((x - self.origin) / self.spacing).floor().max(0.0) as usize).min(self.cells - 1)
+    }
 }
 
 /// How material point domains are updated at the end of a load step (§3.3).
