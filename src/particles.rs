@@ -1,6 +1,7 @@
 //! Material points: position, influence domain, volume, mass and the committed
 //! deformation/constitutive state, stored as structure-of-arrays.
 
+use crate::basis::GridAxis;
 use crate::error::{require_count, require_positive, InputError};
 use crate::grid::Grid;
 use crate::kinematics::PointState;
@@ -142,19 +143,11 @@ impl<const D: usize> MaterialPoints<D> {
     /// large runs, which no committed study uses. Returns the permutation: new point `k` is
     /// old point `order[k]`.
     pub fn sort_by_cell(&mut self, grid: &Grid<D>) -> Vec<usize> {
+        let axes: [GridAxis; D] = std::array::from_fn(|a| GridAxis::of(grid, a));
         let cell = |x: &SVector<f64, D>| {
-            let mut flat = 0usize;
-            for a in (0..D).rev() {
-                let n = grid.cells()[a];
-                let i = ((x[a] - grid.origin()[a]) / grid.spacing()[a]).floor();
-                let i = if i.is_finite() {
-                    (i.max(0.0) as usize).min(n - 1)
-                } else {
-                    0
-                };
-                flat = flat * n + i;
-            }
-            flat
+            (0..D)
+                .rev()
+                .fold(0usize, |flat, a| flat * axes[a].cells + axes[a].cell_of(x[a]))
         };
         let keys: Vec<usize> = self.position.iter().map(cell).collect();
         let mut order: Vec<usize> = (0..self.len()).collect();
