@@ -271,9 +271,11 @@ fn main() {
             bandwidth,
         );
         if let Some(h) = hardware {
+            let all = counts.flops + counts.constitutive_flops;
             println!(
-                "    against the hardware FMA peak: {:.1} %",
-                100.0 * (counts.flops + counts.constitutive_flops) / counts.time / h
+                "    against the hardware FMA peak: {:.1} %, measured / bound {:.2}",
+                100.0 * all / counts.time / h,
+                counts.time / (all / h).max(counts.bytes / bandwidth)
             );
         }
     }
