@@ -72,6 +72,22 @@ pub fn require_positive(field: &str, value: f64) -> Result<(), InputError> {
     }
 }
 
+/// A quantity derived from the inputs (gravity from W, ρ₀ and L; a period from L, E and ρ)
+/// must be finite, positive and normal: an overflow or underflow there turns the closed forms
+/// built on it into NaN or zero, silently, after every case has been solved. The error names
+/// the input `field` (with its `value`) that the quantity is derived from.
+pub fn require_derived(field: &str, value: f64, derived: &str, d: f64) -> Result<(), InputError> {
+    if d.is_finite() && d >= f64::MIN_POSITIVE {
+        Ok(())
+    } else {
+        Err(InputError::new(
+            field,
+            value,
+            format!("gives {derived} = {d:e}, which must be finite, positive and normal (>= 2.2e-308)"),
+        ))
+    }
+}
+
 /// Check that `value` is finite.
 pub fn require_finite(field: &str, value: f64) -> Result<(), InputError> {
     if value.is_finite() {

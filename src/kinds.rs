@@ -40,8 +40,17 @@ pub struct Request<'a> {
 type RunFn =
     for<'a, 'b> fn(&Request<'a>, RunOptions<'b>) -> Result<(PathBuf, Option<RunSummary>), StudyError>;
 
-/// (name, summary) of a study file's text (and the file as shown), for `study list`.
-type CatalogueFn = fn(&str, &str) -> Result<(String, String), StudyError>;
+/// (name, summary) of a study file's text (and the file as shown), for `study list`, and its
+/// number of cases in the full and the quick tier.
+type CatalogueFn = fn(&str, &str) -> Result<Entry, StudyError>;
+
+/// A valid study file's name, summary and cases per tier.
+struct Entry {
+    name: String,
+    summary: String,
+    full: usize,
+    quick: usize,
+}
 
 /// One registered kind: its `problem` key and what `study` does with it.
 pub struct Kind {
@@ -67,8 +76,13 @@ impl Kind {
     }
 }
 
-fn catalogue_of<K: StudyKind>(text: &str, shown: &str) -> Result<(String, String), StudyError> {
-    K::parse(text, shown).map(|s| (s.name().to_string(), s.summary().to_string()))
+fn catalogue_of<K: StudyKind>(text: &str, shown: &str) -> Result<Entry, StudyError> {
+    K::parse(text, shown).map(|s| Entry {
+        name: s.name().to_string(),
+        summary: s.summary().to_string(),
+        full: s.cases(Tier::Full).0.len(),
+        quick: s.cases(Tier::Quick).0.len(),
+    })
 }
 
 fn run_kind<K: StudyKind>(
@@ -78,14 +92,38 @@ fn run_kind<K: StudyKind>(
     let study = K::parse(r.text, r.shown)?;
     let dir = r.out.join(study.name());
     if r.render_only {
+        // --render-only draws what results.json holds; asked for the quick tier, it must hold it.
+        let held = crate::study::results::read_json::<serde_json::Value>(&dir.join("results.json"))
+            .ok()
+            .and_then(|v| v.get("tier")?.as_str().map(str::to_string));
+        if r.tier == Tier::Quick && held.as_deref().is_some_and(|t| t != "quick") {
+            return Err(StudyError::Invalid {
+                file: dir.join("results.json").display().to_string(),
+                key: "tier".into(),
+                value: format!("{:?}", held.unwrap_or_default()),
+                allowed: "must be \"quick\" for --render-only --quick: --render-only redraws what results.json holds (drop --quick, or run the quick tier first)".into(),
+            });
+        }
         return Ok((dir, None));
     }
     let options = RunOptions {
         study_dir: Some(dir.clone()),
         ..options
     };
+    let vtk = options.vtk.is_some();
     let run = engine::run(&study, r.file_name, r.tier, &options)?;
     engine::write_outputs(r.out, &run)?;
+    // ParaView files belong to the run that wrote them: a run without --vtk removes an older
+    // run's, which would otherwise sit beside results they do not show.
+    let old_vtk = dir.join("vtk");
+    if !vtk && old_vtk.is_dir() {
+        std::fs::remove_dir_all(&old_vtk).map_err(|e| StudyError::io(&old_vtk, e))?;
+        eprintln!(
+            "{}: removed {} of an earlier run (this run wrote no ParaView files; add --vtk for them)",
+            study.name(),
+            old_vtk.display()
+        );
+    }
     Ok((dir, Some(run.results.summary(run.resumed))))
 }
 
@@ -234,6 +272,10 @@ pub fn render_methods(out: &Path) -> Result<Option<Rendered>, StudyError> {
 
 /// (name, summary) of a study file for `study list`.
 pub fn catalogue_entry(file: &Path) -> Result<(String, String), StudyError> {
+    entry(file).map(|e| (e.name, e.summary))
+}
+
+fn entry(file: &Path) -> Result<Entry, StudyError> {
     let text = std::fs::read_to_string(file).map_err(|e| StudyError::io(file, e))?;
     let shown = file.display().to_string();
     let k = kind_of_study(&text, &shown)?;
@@ -242,30 +284,45 @@ pub fn catalogue_entry(file: &Path) -> Result<(String, String), StudyError> {
 
 /// Parse and validate every study file of a run, and reject two files with one `name` (they
 /// would write the same output folder): every error, or `Ok` if all are valid.
-pub fn validate_files(files: &[PathBuf]) -> Result<(), Vec<StudyError>> {
+pub fn validate_files(files: &[PathBuf], tier: Tier) -> Result<(), Vec<StudyError>> {
     let mut errors = vec![];
     let mut names: std::collections::BTreeMap<String, String> = Default::default();
+    let mut counts = vec![];
     for f in files {
-        match catalogue_entry(f) {
-            Ok((name, _)) => {
+        match entry(f) {
+            Ok(e) => {
                 let shown = f.display().to_string();
-                if let Some(first) = names.get(&name) {
+                counts.push((e.name.clone(), if tier == Tier::Quick { e.quick } else { e.full }));
+                if let Some(first) = names.get(&e.name) {
                     if *first != shown {
                         errors.push(StudyError::Invalid {
                             file: shown,
                             key: "name".into(),
-                            value: format!("{name:?}"),
+                            value: format!("{:?}", e.name),
                             allowed: format!(
                                 "already the name of {first}: each study needs its own name (its output folder)"
                             ),
                         });
                     }
                 } else {
-                    names.insert(name, shown);
+                    names.insert(e.name, shown);
                 }
             }
             Err(e) => errors.push(e),
         }
+    }
+    let total: usize = counts.iter().map(|c| c.1).sum();
+    if errors.is_empty() && total > crate::study::MAX_CASES_PER_RUN {
+        let each: Vec<String> = counts.iter().map(|(n, c)| format!("{n} {c}")).collect();
+        errors.push(StudyError::Invalid {
+            file: files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", "),
+            key: "sweeps".into(),
+            value: format!("{total} cases in the {} tier ({})", tier.name(), each.join(", ")),
+            allowed: format!(
+                "one run must solve at most {} cases (igimp::study::MAX_CASES_PER_RUN): split the sweeps, or run the study files one by one",
+                crate::study::MAX_CASES_PER_RUN
+            ),
+        });
     }
     if errors.is_empty() {
         Ok(())

@@ -42,6 +42,7 @@
 pub mod assembly;
 pub mod atomic_file;
 pub mod basis;
+pub mod budget;
 pub mod constitutive;
 pub mod direct;
 pub mod dofs;

@@ -6,6 +6,32 @@ use crate::error::{SolveError, StepFailure};
 use crate::newton::{NewtonReport, NewtonSettings};
 use serde::{Deserialize, Serialize};
 
+/// Most load or time steps of one analysis, material point or finite element. A sanity
+/// bound, not a tuned limit: every study uses at most a few thousand steps (cut-backs
+/// included), and a count beyond it is a typo that would run for days.
+pub const MAX_LOAD_STEPS: usize = 1_000_000;
+
+/// `periods × steps_per_period` time steps, at most [`MAX_LOAD_STEPS`]: checked in floating
+/// point before the count is rounded to an integer; the error names the periods' `field`.
+pub fn require_time_steps(
+    field: &str,
+    periods: f64,
+    steps_per_period: usize,
+) -> Result<(), crate::error::InputError> {
+    let steps = periods * steps_per_period as f64;
+    if steps <= MAX_LOAD_STEPS as f64 {
+        return Ok(());
+    }
+    Err(crate::error::InputError::new(
+        field,
+        periods,
+        format!(
+            "periods × steps_per_period = {} time steps must be <= {MAX_LOAD_STEPS}",
+            crate::error::shortest(steps.round())
+        ),
+    ))
+}
+
 /// The steps of a run and its failure, if any: the form the problems record a run in,
 /// whether it converged or stopped at a failing step.
 pub fn steps_and_failure(

@@ -89,18 +89,18 @@ impl MpmSettings {
         if let Some(n) = &self.dynamics {
             n.validate()?;
         }
-        // A sanity bound, not a tuned limit: every study uses at most a few hundred steps
-        // (cut-backs included), and a count beyond it is a typo that would run for days.
-        if self.load_steps > 1_000_000 {
+        if self.load_steps > MAX_LOAD_STEPS {
             return Err(InputError::new(
                 "load_steps",
                 self.load_steps,
-                "must be <= 1000000",
+                format!("must be <= {MAX_LOAD_STEPS}"),
             ));
         }
         Ok(())
     }
 }
+
+pub use crate::load_stepping::MAX_LOAD_STEPS;
 
 /// External loads at the end of the analysis, applied proportionally over the load steps.
 #[derive(Debug, Clone)]

@@ -1,6 +1,6 @@
 //! Full Newton–Raphson on the out-of-balance force of one load step (eqs 21–23).
 
-use crate::error::{require_count, require_positive, InputError, StepFailure};
+use crate::error::{require_count, InputError, StepFailure};
 use serde::{Deserialize, Serialize};
 
 /// Upper bound of [`NewtonSettings::max_iterations`]: far beyond any useful Newton run, and
@@ -72,12 +72,11 @@ impl Default for NewtonSettings {
 
 impl NewtonSettings {
     pub fn validate(&self) -> Result<(), InputError> {
-        require_positive("newton.tolerance", self.tolerance)?;
-        if self.tolerance >= 1.0 {
+        if !(self.tolerance.is_finite() && (MIN_TOLERANCE..1.0).contains(&self.tolerance)) {
             return Err(InputError::new(
                 "newton.tolerance",
                 self.tolerance,
-                "must lie in (0, 1)",
+                format!("must lie in [{MIN_TOLERANCE:e}, 1) (below it the force balance is under round-off)"),
             ));
         }
         require_count("newton.max_iterations", self.max_iterations, 1)?;
@@ -270,6 +269,11 @@ pub fn solve(
 /// 1e-9 (accepted); ν = 0.49999999 at 3.4e-5 (a failure, 3.4e4 times the tolerance). One
 /// decade keeps the accepted answer within one decade of the requested force balance.
 pub const FLOOR_ACCEPT_FACTOR: f64 = 10.0;
+
+/// Smallest Newton tolerance accepted: the lowest round-off floor measured, the 50-element
+/// column's 2e-13 (reference/README.md item 5), rounded down a factor 2. A tolerance below it
+/// cannot be met by any case: every step would end stalled and every case fail.
+pub const MIN_TOLERANCE: f64 = 1e-13;
 
 /// Iterations in a row without halving the best residual that make a stall.
 pub const STALL_WINDOW: usize = 3;

@@ -112,6 +112,14 @@ impl<const D: usize> MaterialPoints<D> {
             counts[a] = n.round() as usize;
         }
         let total: usize = counts.iter().product();
+        // Supports reach up to two cells either side (GIMP domains, B-splines).
+        crate::budget::CaseSize {
+            dimension: D,
+            nodes: grid.num_nodes() as f64,
+            points: counts.iter().map(|&n| n as f64).product(),
+            coupled_nodes: crate::budget::stencil(D, 2),
+        }
+        .check("points_per_cell", format!("{per_cell:?}"))?;
         if total > 20_000_000 {
             return Err(InputError::new(
                 "number of material points",

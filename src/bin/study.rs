@@ -8,7 +8,7 @@ use clap::{CommandFactory, FromArgMatches, Parser};
 use igimp::kinds;
 use igimp::study::checks::{check_counts, CheckRecord};
 use igimp::study::engine::RunOptions;
-use igimp::study::results::{read_json, CaseStatus};
+use igimp::study::results::{read_json, CaseStatus, Failures};
 use igimp::study::vtk_output::VtkOptions;
 use igimp::study::{study_files, Distribution, StudyError, Tier};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -45,7 +45,9 @@ struct Cli {
     /// Folder of the study files.
     #[arg(long, value_name = "DIR")]
     studies_dir: Option<PathBuf>,
-    /// Exit with status 2 if an expected rate or comparison fails or could not be evaluated.
+    /// Exit with status 2 if an expected rate or comparison fails or could not be evaluated,
+    /// or a case failed (or was rejected) that its study file does not declare in
+    /// `[[expected_failures]]`.
     #[arg(long)]
     check: bool,
     /// Reuse the cases an earlier (e.g. interrupted) run finished with the same inputs
@@ -271,10 +273,15 @@ fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
         ),
         None => eprintln!("{name}: rendered {} files into {}", files.len(), dir.display()),
     }
-    let checks: Vec<CheckRecord> = read_json::<serde_json::Value>(&dir.join("results.json"))
-        .ok()
+    let results = read_json::<serde_json::Value>(&dir.join("results.json")).ok();
+    let checks: Vec<CheckRecord> = results
+        .as_ref()
         .and_then(|v| serde_json::from_value(v.get("checks")?.clone()).ok())
         .unwrap_or_default();
+    let failures = results.as_ref().map(Failures::of).unwrap_or_default();
+    if let Some(line) = failures.line() {
+        eprintln!("{name}: cases: {line}");
+    }
     let (pass, fail, none) = check_counts(&checks);
     eprintln!("{name}: checks: {pass} passed, {fail} failed, {none} not evaluated");
     for c in checks.iter().filter(|c| c.pass != Some(true)) {
@@ -286,7 +293,7 @@ fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
             c.limit
         );
     }
-    Ok(fail == 0 && none == 0)
+    Ok(fail == 0 && none == 0 && failures.unexpected.is_empty())
 }
 
 fn main() -> ExitCode {
@@ -313,13 +320,24 @@ fn main() -> ExitCode {
     let dir = cli.studies_dir.clone().unwrap_or_else(default_studies_dir);
 
     if cli.studies.iter().any(|s| s == "list") {
+        if cli.studies.len() > 1 {
+            eprintln!(
+                "error: `list` takes no study names (got {}); run `study list` alone, or name the studies to run",
+                cli.studies.join(" ")
+            );
+            return ExitCode::from(2);
+        }
+        let mut ok = true;
         for entry in catalogue(&dir) {
             match entry {
                 Ok((name, summary)) => println!("{name:<12} {summary}"),
-                Err(e) => println!("(invalid) {e}"),
+                Err(e) => {
+                    ok = false;
+                    eprintln!("error: {e}");
+                }
             }
         }
-        return ExitCode::SUCCESS;
+        return if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE };
     }
     let files: Vec<PathBuf> = if cli.studies.iter().any(|s| s == "all") {
         match study_files(&dir) {
@@ -330,12 +348,25 @@ fn main() -> ExitCode {
             }
         }
     } else {
-        cli.studies.iter().map(|s| resolve(&dir, s)).collect()
+        // A file named twice (by name and by path, say) is solved once.
+        let mut seen = std::collections::BTreeSet::new();
+        let mut files = vec![];
+        for f in cli.studies.iter().map(|s| resolve(&dir, s)) {
+            let canonical = std::fs::canonicalize(&f).unwrap_or_else(|_| f.clone());
+            if seen.insert(canonical) {
+                files.push(f);
+            } else {
+                eprintln!("note: {} is named more than once; it runs once", f.display());
+            }
+        }
+        files
     };
+    let all = cli.studies.iter().any(|s| s == "all");
     // Every file is checked before any is solved: a bad third file must not be found after
     // the first two have run for an hour, and two files of one `name` would overwrite each
     // other's output folder.
-    if let Err(errors) = kinds::validate_files(&files) {
+    let tier = if cli.quick { Tier::Quick } else { Tier::Full };
+    if let Err(errors) = kinds::validate_files(&files, tier) {
         for e in &errors {
             eprintln!("error: {e}");
         }
@@ -347,14 +378,25 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     let mut all_ok = true;
+    let mut without_results = vec![];
     for f in &files {
         match run_one(f, &cli) {
             Ok(ok) => all_ok &= ok,
+            // `study all --render-only` renders the studies that have results and lists the
+            // others; a study named on its own is an error without them.
+            Err(StudyError::NoResults { study, .. }) if all && cli.render_only => without_results.push(study),
             Err(e) => {
                 eprintln!("error: {e}");
                 return ExitCode::FAILURE;
             }
         }
+    }
+    if !without_results.is_empty() {
+        eprintln!(
+            "not rendered, no results.json in {} (solve them first): {}",
+            cli.out.display(),
+            without_results.join(", ")
+        );
     }
     if let Err(e) = std::fs::create_dir_all(&cli.out)
         .map_err(|e| StudyError::Io {
@@ -368,7 +410,9 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     if cli.check && !all_ok {
-        eprintln!("error: some expected rates or comparisons failed or were not evaluated (--check)");
+        eprintln!(
+            "error: some expected rates or comparisons failed or were not evaluated, or a case failed that its study does not expect (--check)"
+        );
         return ExitCode::from(2);
     }
     ExitCode::SUCCESS

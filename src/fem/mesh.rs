@@ -199,6 +199,16 @@ impl<const D: usize, E: ElementFamily<D>> ElementMesh<D, E> {
             crate::error::require_positive(&format!("mesh size[{a}]"), size[a])?;
         }
         let r = if element.quadratic() { 2 } else { 1 };
+        // Checked in floating point before any product of counts can overflow or allocate:
+        // the lattice's nodes (an upper bound of the mesh's) and Gauss points (r + 1 per axis).
+        let cells_f: f64 = cells.iter().map(|&c| c as f64).product();
+        crate::budget::CaseSize {
+            dimension: D,
+            nodes: cells.iter().map(|&c| r as f64 * c as f64 + 1.0).product(),
+            points: cells_f * ((r + 1) as f64).powi(D as i32),
+            coupled_nodes: crate::budget::stencil(D, r),
+        }
+        .check("mesh cells", format!("{cells:?}"))?;
         let m: [usize; D] = std::array::from_fn(|a| r * cells[a] + 1);
         let total: usize = m.iter().product();
         let lattice = |mut flat: usize| -> [usize; D] {

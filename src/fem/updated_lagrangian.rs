@@ -13,8 +13,7 @@ use crate::load_stepping::Increment;
 use crate::newton::NewtonSettings;
 use nalgebra::SVector;
 
-/// Most load steps an analysis may ask for.
-pub const MAX_LOAD_STEPS: usize = 1_000_000;
+pub use crate::load_stepping::MAX_LOAD_STEPS;
 
 /// Check the Newton settings and the number of load steps (1..=[`MAX_LOAD_STEPS`]).
 pub fn validate_stepping(newton: &NewtonSettings, load_steps: usize) -> Result<(), InputError> {

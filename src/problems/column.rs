@@ -6,7 +6,7 @@
 
 use crate::basis::Basis;
 use crate::constitutive::{lame, ConstitutiveModel, LinearElastic};
-use crate::error::{require_count, require_positive, InputError, SolveError};
+use crate::error::{require_count, require_derived, require_positive, InputError, SolveError};
 use crate::fem::{
     HexElement, HexMesh, LineElement, LineFem, LineFemSettings, LineLoads, LineMesh, PlaneFemSettings,
     SolidFem, SolidLoads,
@@ -371,6 +371,22 @@ impl ColumnSpec {
         self.model()?;
         if let Some(n) = self.gauss_points {
             crate::quadrature::GaussRule::try_new(n)?;
+        }
+        // The load and the closed form's scales (eq 45): g, ρ0 g and M L0 / W.
+        let (w, rho, l) = (self.weight, self.density, self.length);
+        let with = |what: &str| format!("{what}, with W = {w:e}, ρ0 = {rho:e} and L0 = {l:e},");
+        require_derived("length", l, &with("the gravity g = W/(ρ0 L0)"), self.gravity())?;
+        require_derived("length", l, &with("the unit weight W/L0"), w / l)?;
+        let (lambda, mu) = lame(self.young_modulus, self.poisson_ratio);
+        let m = lambda + 2.0 * mu;
+        require_derived("length", l, &with("the closed form's scale M L0/W"), m * l / w)?;
+        if let Some(y) = self.yield_stress {
+            require_derived(
+                "yield_stress",
+                y,
+                &with("the yield height scale σy L0/W"),
+                y * l / w,
+            )?;
         }
         let s = -self.weight / self.young_modulus;
         if s < -1e3 {

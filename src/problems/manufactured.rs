@@ -144,9 +144,21 @@ impl ManufacturedSpec {
             Field::AxisAligned => 1.0 / PI,
             Field::Vortex => PI,
         };
+        let key = match self.field {
+            Field::AxisAligned => "amplitude.axis_aligned",
+            Field::Vortex => "amplitude.vortex",
+        };
+        if self.amplitude == 0.0 {
+            // The undeformed body: every error is zero and no rate can be fitted.
+            return Err(InputError::new(
+                key,
+                self.amplitude,
+                "must not be 0 (the field would leave the body undeformed: every error 0, no rate)",
+            ));
+        }
         if !(self.amplitude.is_finite() && self.amplitude.abs() < max_amplitude) {
             return Err(InputError::new(
-                "amplitude",
+                key,
                 self.amplitude,
                 format!(
                     "must be finite with |amplitude| < {max_amplitude:.4} for {}",

@@ -88,6 +88,8 @@ pub trait StudyKind: Serialize + DeserializeOwned + Clone + Sync {
     fn name(&self) -> &str;
     /// One line for `study list`.
     fn summary(&self) -> &str;
+    /// The cases the study file declares expected to fail.
+    fn expected_failures(&self) -> &[super::vocabulary::ExpectedFailure];
     /// Every distinct case of the tier in file order (the order shards split) and the case
     /// ids of each sweep.
     fn cases(&self, tier: Tier) -> (Vec<Self::Case>, SweepIndex);
@@ -105,8 +107,77 @@ pub trait StudyKind: Serialize + DeserializeOwned + Clone + Sync {
     /// Parse and validate a study file's text; `file` names it in errors.
     fn parse(text: &str, file: &str) -> Result<Self, StudyError> {
         let spec: Self = super::vocabulary::parse_toml(text, file)?;
-        spec.validate(file)?;
+        spec.validate(file)
+            .and_then(|_| spec.check_expected_failures(file))
+            .and_then(|_| spec.check_sweeps_distinct(file, text))
+            .map_err(|e| super::locate::locate(text, e))?;
         Ok(spec)
+    }
+
+    /// No sweep lists a value twice (it would name one case twice, solved once), and each
+    /// tier solves at least one case.
+    fn check_sweeps_distinct(&self, file: &str, text: &str) -> Result<(), StudyError> {
+        let chk = super::vocabulary::Checker { file };
+        let order: Vec<String> = text
+            .parse::<toml::Table>()
+            .ok()
+            .and_then(|t| t.get("sweeps")?.as_array().cloned())
+            .unwrap_or_default()
+            .iter()
+            .map(|s| s.get("id").and_then(|v| v.as_str()).unwrap_or("").to_string())
+            .collect();
+        for tier in [Tier::Full, Tier::Quick] {
+            let (cases, index) = self.cases(tier);
+            if cases.is_empty() {
+                return Err(chk.err(
+                    "sweeps",
+                    format!("{} tier: 0 cases", tier.name()),
+                    "must give each tier at least one case (every sweep is skipped or empty)",
+                ));
+            }
+            for (sweep, ids) in &index {
+                let mut seen = std::collections::BTreeSet::new();
+                if let Some(twice) = ids.iter().find(|id| !seen.insert(id.as_str())) {
+                    let key = match order.iter().position(|s| s == sweep) {
+                        Some(i) => format!("sweeps[{i}]"),
+                        None => format!("sweep {sweep:?}"),
+                    };
+                    return Err(chk.err(
+                        key,
+                        format!("{sweep:?}"),
+                        format!(
+                            "must not list a value twice in the {} tier: case {twice} would be named twice and solved once",
+                            tier.name()
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Each declared expected failure names cases of the study (a pattern matching none is a
+    /// stale declaration) and gives its reason.
+    fn check_expected_failures(&self, file: &str) -> Result<(), StudyError> {
+        let chk = super::vocabulary::Checker { file };
+        let mut ids = vec![];
+        for tier in [Tier::Full, Tier::Quick] {
+            ids.extend(self.cases(tier).0.iter().map(|c| self.key(c).id));
+        }
+        for (i, e) in self.expected_failures().iter().enumerate() {
+            chk.text(&format!("expected_failures[{i}].reason"), &e.reason)?;
+            chk.non_empty(&format!("expected_failures[{i}].cases"), &e.cases)?;
+            for (j, p) in e.cases.iter().enumerate() {
+                if !ids.iter().any(|id| super::vocabulary::glob_match(p, id)) {
+                    return Err(chk.err(
+                        format!("expected_failures[{i}].cases[{j}]"),
+                        format!("{p:?}"),
+                        "must match the id of a case of the study (`*` matches any characters)",
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Read, parse and validate a study file.
@@ -128,6 +199,9 @@ macro_rules! study_file_fields {
         }
         fn summary(&self) -> &str {
             &self.summary
+        }
+        fn expected_failures(&self) -> &[$crate::study::vocabulary::ExpectedFailure] {
+            &self.expected_failures
         }
     };
 }

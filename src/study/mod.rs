@@ -19,6 +19,7 @@ pub mod column;
 pub mod compaction;
 pub mod dynamics;
 pub mod engine;
+pub mod locate;
 pub mod manufactured;
 pub mod methods;
 pub mod replace;
@@ -30,6 +31,11 @@ pub mod vtk_output;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
+
+/// Most cases one run of `study` solves, all its study files together: 10,000 one-step cases
+/// already hold 720 MB resident and write a 240 MB results.json (reference/README.md item 58);
+/// every committed study together has under 1,000 in its full tier.
+pub const MAX_CASES_PER_RUN: usize = 10_000;
 
 /// Version of the study-file layout (the `schema` key).
 pub const SCHEMA_VERSION: i64 = 1;
@@ -49,6 +55,22 @@ pub enum StudyError {
         value: String,
         allowed: String,
     },
+    /// A problem input made invalid by a study file's values, named as the problem calls it
+    /// (`half_width`); [`locate::locate`] turns it into [`StudyError::Invalid`] naming the
+    /// file's key (`block.half_width`) and its line.
+    #[error("{file}: invalid `{field}` = {value}: {allowed} (in case {case}, `{scope}`)")]
+    CaseInput {
+        file: String,
+        /// The section whose case it is, e.g. `sweeps[0]` or `sweeps[0].quick`.
+        scope: String,
+        case: String,
+        field: String,
+        value: String,
+        allowed: String,
+    },
+    /// A study folder without `results.json` (nothing to render).
+    #[error("{path}: No such file or directory (os error 2): solve the study first")]
+    NoResults { study: String, path: String },
     #[error("{path}: {message}")]
     Io { path: String, message: String },
     /// `--shard`: this shard's cases are solved and stored; nothing else is written.

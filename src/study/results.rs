@@ -361,6 +361,71 @@ impl RunSummary {
     }
 }
 
+/// The failed and rejected cases of a `results.json` of any kind: those its study declares
+/// expected (`[[expected_failures]]`), with the reason, and the others.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Failures {
+    pub expected: Vec<(String, String)>,
+    pub unexpected: Vec<(String, CaseStatus)>,
+}
+
+impl Failures {
+    /// Read from a `results.json` parsed as JSON (a case's status is its `status` or its
+    /// `solve.status`).
+    pub fn of(results: &serde_json::Value) -> Self {
+        let declared: Vec<super::vocabulary::ExpectedFailure> = results
+            .pointer("/study/expected_failures")
+            .and_then(|v| serde_json::from_value(v.clone()).ok())
+            .unwrap_or_default();
+        let mut out = Failures::default();
+        let cases = results.get("cases").and_then(|c| c.as_array());
+        for c in cases.into_iter().flatten() {
+            let id = c.get("id").and_then(|v| v.as_str()).unwrap_or("?").to_string();
+            let status = c
+                .get("status")
+                .or_else(|| c.pointer("/solve/status"))
+                .and_then(|v| serde_json::from_value::<CaseStatus>(v.clone()).ok());
+            match status {
+                Some(CaseStatus::Converged) => {}
+                Some(s) => match super::vocabulary::expected_reason(&declared, &id) {
+                    Some(reason) => out.expected.push((id, reason.to_string())),
+                    None => out.unexpected.push((id, s)),
+                },
+                None => out.unexpected.push((id, CaseStatus::Rejected)),
+            }
+        }
+        out
+    }
+
+    /// One line for the terminal: which failures were expected and why (the reasons, each
+    /// once), and which were not.
+    pub fn line(&self) -> Option<String> {
+        let mut reasons: Vec<&str> = self.expected.iter().map(|e| e.1.as_str()).collect();
+        reasons.dedup();
+        let mut parts = vec![];
+        if !self.expected.is_empty() {
+            parts.push(format!(
+                "{} expected to fail ({})",
+                self.expected.len(),
+                reasons.join("; ")
+            ));
+        }
+        if !self.unexpected.is_empty() {
+            let ids: Vec<String> = self
+                .unexpected
+                .iter()
+                .map(|(id, s)| format!("{id} {}", s.word()))
+                .collect();
+            parts.push(format!(
+                "{} NOT expected: {}",
+                self.unexpected.len(),
+                ids.join(", ")
+            ));
+        }
+        (!parts.is_empty()).then(|| parts.join("; "))
+    }
+}
+
 /// Write `value` as JSON (pretty or compact), atomically.
 pub fn write_json<T: Serialize>(path: &Path, value: &T, pretty: bool) -> Result<(), StudyError> {
     let text = if pretty {
@@ -432,12 +497,16 @@ pub fn problem_of_study(text: &str) -> Option<String> {
 pub fn problem_of_results(dir: &Path) -> Result<String, StudyError> {
     let path = dir.join("results.json");
     let text = std::fs::read_to_string(&path).map_err(|e| {
-        let hint = if e.kind() == std::io::ErrorKind::NotFound {
-            ": solve the study first"
+        if e.kind() == std::io::ErrorKind::NotFound {
+            StudyError::NoResults {
+                study: dir
+                    .file_name()
+                    .map_or_else(|| dir.display().to_string(), |n| n.to_string_lossy().into_owned()),
+                path: path.display().to_string(),
+            }
         } else {
-            ""
-        };
-        StudyError::io(&path, format!("{e}{hint}"))
+            StudyError::io(&path, e)
+        }
     })?;
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| StudyError::Parse {
         file: path.display().to_string(),

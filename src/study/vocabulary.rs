@@ -177,6 +177,18 @@ impl Checker<'_> {
     ) -> StudyError {
         invalid(self.file, key, value, allowed)
     }
+    /// Case `case` of the section `scope` (`sweeps[0]`, `cases[2]`) is an invalid problem
+    /// input `e`, whose field the problem names ([`super::locate`] finds the file's key).
+    pub fn case_input(&self, scope: &str, case: &str, e: crate::error::InputError) -> StudyError {
+        StudyError::CaseInput {
+            file: self.file.to_string(),
+            scope: scope.to_string(),
+            case: case.to_string(),
+            field: e.field,
+            value: e.value,
+            allowed: e.allowed,
+        }
+    }
     pub fn count(&self, key: &str, v: i64, lo: i64, hi: i64) -> Result<(), StudyError> {
         if (lo..=hi).contains(&v) {
             Ok(())
@@ -219,14 +231,11 @@ impl Checker<'_> {
         v: &'s str,
         seen: &mut BTreeSet<&'s str>,
     ) -> Result<(), StudyError> {
-        if ident_ok(v) && seen.insert(v) {
+        self.ident(key, v)?;
+        if seen.insert(v) {
             Ok(())
         } else {
-            Err(self.err(
-                key,
-                format!("{v:?}"),
-                format!("must be a unique identifier ({IDENT_RULE})"),
-            ))
+            Err(self.err(key, format!("{v:?}"), "must be unique: another entry has this id"))
         }
     }
     /// A Markdown file name `<identifier>.md`.
@@ -259,8 +268,13 @@ impl Checker<'_> {
         self.markdown_file("report_file", h.report_file)
     }
     pub fn newton(&self, key: &str, n: &NewtonSection) -> Result<(), StudyError> {
-        if !(n.tolerance.is_finite() && n.tolerance > 0.0 && n.tolerance < 1.0) {
-            return Err(self.err(format!("{key}.tolerance"), n.tolerance, "must lie in (0, 1)"));
+        let min = crate::newton::MIN_TOLERANCE;
+        if !(n.tolerance.is_finite() && (min..1.0).contains(&n.tolerance)) {
+            return Err(self.err(
+                format!("{key}.tolerance"),
+                short(n.tolerance),
+                format!("must lie in [{min:e}, 1) (below it the force balance is under round-off: every case would fail)"),
+            ));
         }
         self.count(&format!("{key}.max_iterations"), n.max_iterations, 1, 1000)?;
         if let Some(m) = n.max_cutbacks {
@@ -316,9 +330,28 @@ pub fn invalid(
 
 /// Parse a study file's TOML into `T` (unknown keys are errors through `deny_unknown_fields`).
 pub fn parse_toml<T: DeserializeOwned>(text: &str, file: &str) -> Result<T, StudyError> {
-    toml::from_str(text).map_err(|e| StudyError::Parse {
-        file: file.to_string(),
-        message: e.to_string().trim_end().to_string(),
+    toml::from_str(text).map_err(|e| {
+        let message = e.to_string().trim_end().to_string();
+        // A key missing from the top level is reported at the document's span, line 1 column 1
+        // (often a comment): say where it belongs instead.
+        let top_level = e.span().is_some_and(|s| s.start == 0 && s.end >= text.trim_end().len());
+        let missing = message
+            .lines()
+            .last()
+            .and_then(|l| l.strip_prefix("missing field `"))
+            .and_then(|l| l.strip_suffix('`'));
+        match (top_level, missing) {
+            (true, Some(key)) => StudyError::Parse {
+                file: file.to_string(),
+                message: format!(
+                    "missing required key `{key}` at the top level of the file (with `schema`, `name` and `problem`, before the first [section])"
+                ),
+            },
+            _ => StudyError::Parse {
+                file: file.to_string(),
+                message,
+            },
+        }
     })
 }
 
@@ -350,4 +383,64 @@ pub trait TieredSweep {
 /// A figure of one sweep.
 pub trait SweepFigure {
     fn sweep(&self) -> &str;
+}
+
+/// Cases a study expects to fail (`[[expected_failures]]`): a failure the study means to show
+/// (e.g. Figure 9's untreated one-point series), not a regression. `study --check` fails on
+/// any failed case that no declaration matches, and the run's summary says which failures were
+/// expected.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExpectedFailure {
+    /// Case ids; `*` matches any run of characters.
+    pub cases: Vec<String>,
+    /// Why these cases fail, for the summary and the report.
+    pub reason: String,
+}
+
+/// Whether `id` matches `pattern`, whose `*` matches any run of characters (none included).
+pub fn glob_match(pattern: &str, id: &str) -> bool {
+    let mut parts = pattern.split('*');
+    let first = parts.next().unwrap_or("");
+    let Some(mut rest) = id.strip_prefix(first) else {
+        return false;
+    };
+    let parts: Vec<&str> = parts.collect();
+    let Some((last, middle)) = parts.split_last() else {
+        return rest.is_empty();
+    };
+    for p in middle {
+        match rest.find(p) {
+            Some(i) => rest = &rest[i + p.len()..],
+            None => return false,
+        }
+    }
+    rest.len() >= last.len() && rest.ends_with(last)
+}
+
+/// The reason of the declaration in `declared` matching case `id`, if any.
+pub fn expected_reason<'a>(declared: &'a [ExpectedFailure], id: &str) -> Option<&'a str> {
+    declared
+        .iter()
+        .find(|e| e.cases.iter().any(|p| glob_match(p, id)))
+        .map(|e| e.reason.as_str())
+}
+
+#[cfg(test)]
+mod glob_tests {
+    use super::glob_match;
+
+    #[test]
+    fn glob_matches_runs_and_anchors_both_ends() {
+        assert!(glob_match(
+            "igimp-*-p1-*-untreated",
+            "igimp-w1e4-e128-p1-s20-untreated"
+        ));
+        assert!(glob_match("a*", "a"));
+        assert!(glob_match("*", ""));
+        assert!(glob_match("f-diagonal", "f-diagonal"));
+        assert!(!glob_match("f-diagonal", "f-diagonal-untreated"));
+        assert!(!glob_match("a*b", "ab-c"));
+        assert!(!glob_match("ab*ba", "aba"));
+    }
 }

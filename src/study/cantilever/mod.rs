@@ -224,6 +224,9 @@ pub struct CantileverStudy {
     /// Always "cantilever".
     pub problem: String,
     pub report_file: String,
+    /// Cases expected to fail, and why; `study --check` fails on any other failed case.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expected_failures: Vec<crate::study::vocabulary::ExpectedFailure>,
     /// Also draw and tabulate the plane-stress elastica (the solver is plane strain).
     #[serde(default)]
     pub plane_stress_elastica: bool,

@@ -52,6 +52,16 @@ impl CantileverStudy {
                 )
                 .map_err(|e| chk.err(format!("cases[{i}].method"), c.method.name(), e.allowed))?;
             chk.count(&format!("cases[{i}].snapshot_every"), c.snapshot_every, 0, 10_000)?;
+            if let (Some(u), false) = (c.domain_update, c.method.uses_domain_update()) {
+                return Err(chk.err(
+                    format!("cases[{i}].domain_update"),
+                    format!("{u:?}"),
+                    format!(
+                        "must be absent for {}: only the domain-averaged families (e.g. igimp) update point domains",
+                        c.method.name()
+                    ),
+                ));
+            }
         }
         if self.cases.is_empty() {
             return Err(chk.err("cases", "[]", "must list at least one case"));
@@ -251,9 +261,14 @@ impl CantileverStudy {
             }
         }
         for (c, _) in self.all_cases() {
-            c.spec
-                .validate()
-                .map_err(|e| chk.err(format!("case {}", c.id), e, "must be a valid cantilever input"))?;
+            // A case of `[[cases]]` has its own overrides there; the others (refinements, the
+            // depth study) take the beam's values.
+            let scope = self
+                .cases
+                .iter()
+                .position(|s| s.id == c.id)
+                .map_or_else(String::new, |j| format!("cases[{j}]"));
+            c.spec.validate().map_err(|e| chk.case_input(&scope, &c.id, e))?;
         }
         Ok(())
     }

@@ -233,6 +233,9 @@ pub struct ColumnStudy {
     pub problem: ProblemKind,
     /// File name of the Markdown report inside the study's output folder.
     pub report_file: String,
+    /// Cases expected to fail, and why; `study --check` fails on any other failed case.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expected_failures: Vec<crate::study::vocabulary::ExpectedFailure>,
     pub column: ColumnSection,
     /// Load steps (gravity ramped linearly); 1..=10000.
     pub load_steps: i64,

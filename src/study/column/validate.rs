@@ -99,6 +99,21 @@ impl ColumnStudy {
             }
         }
 
+        // Every case is a valid column (its derived gravity and closed form included).
+        for tier in [crate::study::Tier::Full, crate::study::Tier::Quick] {
+            for (i, s) in self.sweeps.iter().enumerate() {
+                let Some(plan) = self.plan(s, tier) else { continue };
+                let scope = match tier {
+                    crate::study::Tier::Full => format!("sweeps[{i}]"),
+                    crate::study::Tier::Quick => format!("sweeps[{i}].quick"),
+                };
+                for case in self.sweep_cases(&plan) {
+                    case.spec
+                        .validate()
+                        .map_err(|e| c.case_input(&scope, &case.id, e))?;
+                }
+            }
+        }
         for (i, e) in self.expect.iter().enumerate() {
             let k = |f: &str| format!("expect[{i}].{f}");
             let sweep = self.sweep_ref(&c, &k("sweep"), &e.sweep)?;

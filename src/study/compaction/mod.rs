@@ -259,6 +259,9 @@ pub struct CompactionStudy {
     pub problem: String,
     /// Main report file name in the output folder.
     pub report_file: String,
+    /// Cases expected to fail, and why; `study --check` fails on any other failed case.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expected_failures: Vec<crate::study::vocabulary::ExpectedFailure>,
     pub block: BlockSection,
     pub newton: NewtonSection,
     pub weak_nodes: WeakNodeSection,

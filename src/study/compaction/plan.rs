@@ -80,14 +80,11 @@ impl CompactionStudy {
                     )
                     .map_err(|e| chk.err(k(&format!("methods[{j}]")), m.name(), e.allowed))?;
                 }
+                let scope = k("");
                 for c in self.sweep_cases(s, &plan) {
-                    c.spec.validate().map_err(|e| {
-                        chk.err(
-                            format!("sweeps[{i}] case {}", c.id),
-                            e,
-                            "must be a valid compaction input",
-                        )
-                    })?;
+                    c.spec
+                        .validate()
+                        .map_err(|e| chk.case_input(scope.trim_end_matches('.'), &c.id, e))?;
                 }
             }
         }

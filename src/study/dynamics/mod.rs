@@ -301,6 +301,9 @@ pub struct DynamicStudy {
     /// Always "dynamics" ("bar" in files written before the kind had a second problem).
     pub problem: String,
     pub report_file: String,
+    /// Cases expected to fail, and why; `study --check` fails on any other failed case.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expected_failures: Vec<crate::study::vocabulary::ExpectedFailure>,
     /// The vibrating bar; exactly one of `bar` and `manufactured` is given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bar: Option<BarSection>,
@@ -1032,10 +1035,15 @@ impl DynamicStudy {
             }
         }
         for tier in [Tier::Full, Tier::Quick] {
-            for c in self.cases(tier).0 {
-                c.spec
-                    .validate()
-                    .map_err(|e| chk.err(format!("case {}", c.id), e, "must be a valid dynamic input"))?;
+            for (i, s) in self.sweeps.iter().enumerate() {
+                let Some(plan) = s.plan(tier) else { continue };
+                let scope = match tier {
+                    Tier::Full => format!("sweeps[{i}]"),
+                    Tier::Quick => format!("sweeps[{i}].quick"),
+                };
+                for c in self.sweep_cases(s, &plan) {
+                    c.spec.validate().map_err(|e| chk.case_input(&scope, &c.id, e))?;
+                }
             }
         }
         Ok(())

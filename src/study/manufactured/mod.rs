@@ -97,7 +97,7 @@ fn is_plane(d: &i64) -> bool {
     *d == 2
 }
 
-fn default_updates() -> Vec<DomainUpdate> {
+pub(super) fn default_updates() -> Vec<DomainUpdate> {
     vec![DomainUpdate::Stretch]
 }
 
@@ -202,6 +202,9 @@ pub struct ManufacturedStudy {
     /// Always "manufactured".
     pub problem: String,
     pub report_file: String,
+    /// Cases expected to fail, and why; `study --check` fails on any other failed case.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expected_failures: Vec<crate::study::vocabulary::ExpectedFailure>,
     /// 2 (the unit square, plane strain; the default) or 3 (the unit cube: methods mpm,
     /// igimp, fem-hex8, fem-hex20; points_per_cell³ points per cell; no domain figures).
     #[serde(default = "plane", skip_serializing_if = "is_plane")]

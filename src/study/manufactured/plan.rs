@@ -61,6 +61,15 @@ impl ManufacturedStudy {
             chk.unique_ident(&format!("sweeps[{i}].id"), &s.id, &mut ids)?;
             chk.text(&format!("sweeps[{i}].title"), &s.title)?;
             chk.non_empty(&format!("sweeps[{i}].domain_updates"), &s.domain_updates)?;
+            if !s.methods.iter().any(|m| m.uses_domain_update())
+                && s.domain_updates != super::default_updates()
+            {
+                return Err(chk.err(
+                    format!("sweeps[{i}].domain_updates"),
+                    format!("{:?}", s.domain_updates),
+                    "must be left out: none of the sweep's methods updates point domains (only the domain-averaged families, e.g. igimp, do)",
+                ));
+            }
             if let Some(n) = s.fit_points {
                 chk.count(&format!("sweeps[{i}].fit_points"), n, 2, 100)?;
             }
@@ -103,14 +112,11 @@ impl ManufacturedStudy {
                         max_points_per_axis(dimension as u32),
                     )?;
                 }
+                let scope = k("");
                 for c in self.sweep_cases(s, &plan) {
-                    c.spec.validate().map_err(|e| {
-                        chk.err(
-                            format!("sweeps[{i}] case {}", c.id),
-                            e,
-                            "must be a valid manufactured input",
-                        )
-                    })?;
+                    c.spec
+                        .validate()
+                        .map_err(|e| chk.case_input(scope.trim_end_matches('.'), &c.id, e))?;
                 }
             }
         }
