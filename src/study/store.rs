@@ -4,9 +4,15 @@
 //! Every file a study writes goes through [`write_atomic`] (write a temporary file in the same
 //! folder, flush it to disk, rename it over the target), so killing the run at any moment
 //! leaves either the old file or the new one, never a truncated one. [`CaseStore`] keeps one
-//! JSON file per finished case, `cases/<case-id>.json`, holding the hash of the case's inputs
-//! ([`case_hash`]) beside its record; `study --resume` reuses a stored record when the hash
-//! of the case to run matches, and solves the case again otherwise.
+//! JSON file per finished case, `cases/<case-id>.json`, holding beside its record the hash of
+//! the case's inputs ([`case_hash`]), the identity of the build that wrote it ([`BuildId`])
+//! and a digest of the file's own content. `study --resume` reuses a stored record only when
+//! all three match (the build's by choice, `--reuse-other-builds`) and otherwise solves the
+//! case again, saying why ([`Refusal`]).
+//!
+//! The content digest is FNV-1a of the stored object's canonical JSON without its `digest`
+//! key: it catches accidents (a truncated or corrupted file) and hand edits, not an adversary,
+//! who can recompute it.
 //!
 //! The store is generic over the record type; [`super::engine`] uses it for every kind.
 
@@ -63,15 +69,93 @@ pub fn confined(dir: &Path, name: &str) -> Result<PathBuf, StudyError> {
     }
 }
 
+/// The build a record was written by. Records are compared by `source` alone, the digest of
+/// the sources, features and target the binary was built from (build.rs): it tells two dirty
+/// trees apart, which commit and dirty flag cannot, and survives a commit that changes no
+/// source. `commit` and `dirty` are for people reading a refusal.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct BuildId {
+    pub source: String,
+    pub commit: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dirty: Option<bool>,
+}
+
+impl BuildId {
+    /// This binary's build.
+    pub fn this_build() -> Self {
+        let software = super::results::Software::this_build();
+        BuildId {
+            source: env!("IGIMP_SOURCE_DIGEST").to_string(),
+            commit: software.commit.unwrap_or_else(|| "unknown".into()),
+            dirty: software.dirty,
+        }
+    }
+}
+
+impl std::fmt::Display for BuildId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let c = &self.commit;
+        write!(f, "sources {}, commit {}", self.source, &c[..c.len().min(12)])?;
+        if self.dirty == Some(true) {
+            write!(f, " with uncommitted changes")?;
+        }
+        Ok(())
+    }
+}
+
+/// Why a stored record is not reused.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Refusal {
+    /// No record of the case (nothing to say: the case was never finished).
+    Absent,
+    /// Not valid JSON of the store's layout, or not readable at all.
+    Unreadable(String),
+    /// Content that does not match its digest, or a file holding another case.
+    Edited(String),
+    /// Written for other inputs (the study file changed).
+    OtherInputs,
+    /// Written by another build; `None`: by one that recorded no build and no digest (before
+    /// records carried them), which cannot be checked and is never reused.
+    OtherBuild(Option<BuildId>),
+}
+
+impl std::fmt::Display for Refusal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Refusal::Absent => write!(f, "not stored"),
+            Refusal::Unreadable(e) => write!(f, "truncated or unreadable ({e})"),
+            Refusal::Edited(e) => write!(f, "edited or corrupt ({e})"),
+            Refusal::OtherInputs => write!(f, "written for other inputs (the case's definition changed)"),
+            Refusal::OtherBuild(Some(b)) => write!(
+                f,
+                "written by another build ({b}; this build: {}); --reuse-other-builds reuses it",
+                BuildId::this_build()
+            ),
+            Refusal::OtherBuild(None) => write!(
+                f,
+                "written by another build, one that recorded neither its identity nor a content \
+                 digest, so it cannot be checked (not reused even with --reuse-other-builds)"
+            ),
+        }
+    }
+}
+
+/// A case file: the stored object whose canonical JSON, without `digest`, the digest covers.
 #[derive(Serialize, Deserialize)]
 struct Stored<T> {
     id: String,
     hash: String,
+    /// Absent in records written before builds were recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    build: Option<BuildId>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    digest: Option<String>,
     record: T,
 }
 
 /// One JSON file per finished case, `<dir>/<case-id>.json`, holding the hash of the case's
-/// inputs and its record.
+/// inputs, the build that wrote it, its content digest and its record.
 #[derive(Debug, Clone)]
 pub struct CaseStore {
     dir: PathBuf,
@@ -98,23 +182,63 @@ impl CaseStore {
         confined(&self.dir, &format!("{id}.json"))
     }
 
-    /// The stored record of case `id` if it was written for inputs with hash `hash`; `None`
-    /// if absent, unreadable, for other inputs, or of another layout.
-    pub fn load<T: DeserializeOwned>(&self, id: &str, hash: &str) -> Option<T> {
-        let text = std::fs::read_to_string(self.path(id).ok()?).ok()?;
-        let stored: Stored<T> = serde_json::from_str(&text).ok()?;
-        (stored.id == id && stored.hash == hash).then_some(stored.record)
+    /// The stored record of case `id` if its content matches its digest, it was written for
+    /// inputs with hash `hash`, and by this build (or any build, with `other_builds`: the
+    /// digest must match all the same); otherwise why not.
+    pub fn load<T: DeserializeOwned>(&self, id: &str, hash: &str, other_builds: bool) -> Result<T, Refusal> {
+        let path = self.path(id).map_err(|e| Refusal::Unreadable(e.to_string()))?;
+        let bytes = match std::fs::read(&path) {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(Refusal::Absent),
+            Err(e) => return Err(Refusal::Unreadable(e.to_string())),
+        };
+        let mut value: serde_json::Value =
+            serde_json::from_slice(&bytes).map_err(|e| Refusal::Unreadable(e.to_string()))?;
+        let object = value
+            .as_object_mut()
+            .ok_or_else(|| Refusal::Unreadable("not a JSON object".into()))?;
+        let digest = object.remove("digest");
+        if digest.is_none() && !object.contains_key("build") {
+            return Err(Refusal::OtherBuild(None));
+        }
+        if digest.as_ref().and_then(|d| d.as_str()) != Some(case_hash(&*object).as_str()) {
+            return Err(Refusal::Edited("its content does not match its digest".into()));
+        }
+        let stored: Stored<serde_json::Value> =
+            serde_json::from_value(value).map_err(|e| Refusal::Unreadable(e.to_string()))?;
+        if stored.id != id {
+            return Err(Refusal::Edited(format!("it holds case {:?}", stored.id)));
+        }
+        if stored.hash != hash {
+            return Err(Refusal::OtherInputs);
+        }
+        let this_build = stored
+            .build
+            .as_ref()
+            .is_some_and(|b| b.source == BuildId::this_build().source);
+        if !this_build && !other_builds {
+            return Err(Refusal::OtherBuild(stored.build));
+        }
+        serde_json::from_value(stored.record).map_err(|e| Refusal::Unreadable(e.to_string()))
     }
 
-    /// Store the record of case `id` with its input hash, atomically.
+    /// Store the record of case `id` with its input hash, this build and the content digest,
+    /// atomically.
     pub fn save<T: Serialize>(&self, id: &str, hash: &str, record: &T) -> Result<(), StudyError> {
         let path = self.path(id)?;
         let stored = Stored {
             id: id.to_string(),
             hash: hash.to_string(),
+            build: Some(BuildId::this_build()),
+            digest: None,
             record,
         };
-        let json = serde_json::to_string(&stored).map_err(|e| StudyError::io(&path, e))?;
+        let mut value = serde_json::to_value(&stored).map_err(|e| StudyError::io(&path, e))?;
+        let digest = case_hash(&value);
+        if let Some(o) = value.as_object_mut() {
+            o.insert("digest".into(), digest.into());
+        }
+        let json = serde_json::to_string(&value).map_err(|e| StudyError::io(&path, e))?;
         write_file(&path, json.as_bytes())
     }
 }
@@ -156,8 +280,95 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let store = CaseStore::open(dir.path()).unwrap();
         store.save("c1", "00ff", &vec![1.5, 2.5]).unwrap();
-        assert_eq!(store.load::<Vec<f64>>("c1", "00ff"), Some(vec![1.5, 2.5]));
-        assert_eq!(store.load::<Vec<f64>>("c1", "00fe"), None);
-        assert_eq!(store.load::<Vec<f64>>("c2", "00ff"), None);
+        assert_eq!(store.load::<Vec<f64>>("c1", "00ff", false), Ok(vec![1.5, 2.5]));
+        assert_eq!(
+            store.load::<Vec<f64>>("c1", "00fe", false),
+            Err(Refusal::OtherInputs)
+        );
+        assert_eq!(store.load::<Vec<f64>>("c2", "00ff", false), Err(Refusal::Absent));
+    }
+
+    /// `c1` stored, its file read as JSON, changed by `edit`, written back and loaded.
+    fn load_edited(
+        edit: impl Fn(&mut serde_json::Map<String, serde_json::Value>),
+        other_builds: bool,
+    ) -> Result<Vec<f64>, Refusal> {
+        let dir = tempfile::tempdir().unwrap();
+        let store = CaseStore::open(dir.path()).unwrap();
+        store.save("c1", "00ff", &vec![1.5, 2.5]).unwrap();
+        let path = store.path("c1").unwrap();
+        let mut v: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+        edit(v.as_object_mut().unwrap());
+        std::fs::write(&path, serde_json::to_string(&v).unwrap()).unwrap();
+        store.load::<Vec<f64>>("c1", "00ff", other_builds)
+    }
+
+    /// The object with `build` replaced and its digest recomputed (what another build writes).
+    fn other_build(o: &mut serde_json::Map<String, serde_json::Value>) {
+        let b = BuildId {
+            source: "0123456789abcdef".into(),
+            ..BuildId::this_build()
+        };
+        o.insert("build".into(), serde_json::to_value(b).unwrap());
+        o.remove("digest");
+        let d = case_hash(&*o);
+        o.insert("digest".into(), d.into());
+    }
+
+    #[test]
+    fn an_edited_record_is_refused_even_from_another_build() {
+        // Reformatting alone (the canonical JSON is unchanged) keeps the record.
+        assert_eq!(load_edited(|_| {}, false), Ok(vec![1.5, 2.5]));
+        let edit = |o: &mut serde_json::Map<String, serde_json::Value>| {
+            o.insert("record".into(), serde_json::json!([1.5, 1e-12]));
+        };
+        assert!(matches!(load_edited(edit, false), Err(Refusal::Edited(_))));
+        assert!(matches!(load_edited(edit, true), Err(Refusal::Edited(_))));
+        let moved = |o: &mut serde_json::Map<String, serde_json::Value>| {
+            o.insert("id".into(), "c0".into());
+            o.remove("digest");
+            let d = case_hash(&*o);
+            o.insert("digest".into(), d.into());
+        };
+        assert!(matches!(load_edited(moved, false), Err(Refusal::Edited(_))));
+    }
+
+    #[test]
+    fn a_record_of_another_build_is_reused_only_on_request() {
+        match load_edited(other_build, false) {
+            Err(Refusal::OtherBuild(Some(b))) => assert_eq!(b.source, "0123456789abcdef"),
+            r => panic!("{r:?}"),
+        }
+        assert_eq!(load_edited(other_build, true), Ok(vec![1.5, 2.5]));
+        // The layout before builds were recorded: never reused, it cannot be checked.
+        let old = |o: &mut serde_json::Map<String, serde_json::Value>| {
+            o.remove("build");
+            o.remove("digest");
+        };
+        assert_eq!(load_edited(old, false), Err(Refusal::OtherBuild(None)));
+        assert_eq!(load_edited(old, true), Err(Refusal::OtherBuild(None)));
+    }
+
+    #[test]
+    fn a_truncated_record_is_unreadable() {
+        let dir = tempfile::tempdir().unwrap();
+        let store = CaseStore::open(dir.path()).unwrap();
+        store.save("c1", "00ff", &vec![1.5, 2.5]).unwrap();
+        let path = store.path("c1").unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
+        let r = store.load::<Vec<f64>>("c1", "00ff", false);
+        assert!(
+            matches!(&r, Err(Refusal::Unreadable(e)) if e.contains("EOF")),
+            "{r:?}"
+        );
+    }
+
+    /// This build's identity is the 16 hex digits build.rs writes.
+    #[test]
+    fn this_build_has_a_source_digest() {
+        let b = BuildId::this_build();
+        assert_eq!(b.source.len(), 16);
+        assert!(b.source.bytes().all(|c| c.is_ascii_hexdigit()), "{}", b.source);
     }
 }
