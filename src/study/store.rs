@@ -10,9 +10,12 @@
 //! all three match (the build's by choice, `--reuse-other-builds`) and otherwise solves the
 //! case again, saying why ([`Refusal`]).
 //!
-//! The content digest is FNV-1a of the stored object's canonical JSON without its `digest`
-//! key: it catches accidents (a truncated or corrupted file) and hand edits, not an adversary,
-//! who can recompute it.
+//! The content digest is FNV-1a of the file's bytes without its `,"digest":"…"` member
+//! ([`content_digest`]): any byte changed after the store wrote the file refuses it. It
+//! catches accidents (a truncated or corrupted file) and hand edits, not an adversary, who
+//! can recompute it. It is taken of the bytes as written rather than of a canonical form
+//! ([`case_hash`]'s, through a `serde_json::Value` tree) because such a tree of a large record
+//! holds several times the record's text at once, on top of the solved case.
 //!
 //! The store is generic over the record type; [`super::engine`] uses it for every kind.
 
@@ -30,12 +33,37 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), StudyError> {
 /// 64-bit FNV-1a of `bytes`: stable across platforms, Rust versions and runs (unlike
 /// `std::collections::hash_map::DefaultHasher`, whose algorithm is unspecified).
 pub fn fnv1a64(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    fnv1a64_from(0xcbf2_9ce4_8422_2325, bytes)
+}
+
+/// [`fnv1a64`] of `bytes` continued from the state `h`.
+fn fnv1a64_from(mut h: u64, bytes: &[u8]) -> u64 {
     for &b in bytes {
         h ^= u64::from(b);
         h = h.wrapping_mul(0x0000_0100_0000_01b3);
     }
     h
+}
+
+/// The `digest` member as the store writes it, between `build` and `record`.
+fn digest_member(digest: &str) -> String {
+    format!(",\"digest\":\"{digest}\"")
+}
+
+/// Content digest of a case file's `text`: [`fnv1a64`] of the text without the first
+/// `,"digest":"<digest>"` (none if `digest` is `None`), as 16 hex digits; `None` if the text
+/// does not hold that member.
+pub fn content_digest(text: &[u8], digest: Option<&str>) -> Option<String> {
+    let (before, after) = match digest {
+        None => (text, &text[text.len()..]),
+        Some(d) => {
+            let member = digest_member(d);
+            let at = text.windows(member.len()).position(|w| w == member.as_bytes())?;
+            (&text[..at], &text[at + member.len()..])
+        }
+    };
+    let h = fnv1a64_from(fnv1a64(before), after);
+    Some(format!("{h:016x}"))
 }
 
 /// Hash of a case definition: FNV-1a of its canonical JSON (object keys sorted, floats in
@@ -141,7 +169,7 @@ impl std::fmt::Display for Refusal {
     }
 }
 
-/// A case file: the stored object whose canonical JSON, without `digest`, the digest covers.
+/// A case file, written in this field order (the digest member sits before `record`).
 #[derive(Serialize, Deserialize)]
 struct Stored<T> {
     id: String,
@@ -152,6 +180,17 @@ struct Stored<T> {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     digest: Option<String>,
     record: T,
+}
+
+/// A case file's members but its record (which is skipped, not held).
+#[derive(Deserialize)]
+struct Header {
+    id: String,
+    hash: String,
+    #[serde(default)]
+    build: Option<BuildId>,
+    #[serde(default)]
+    digest: Option<String>,
 }
 
 /// One JSON file per finished case, `<dir>/<case-id>.json`, holding the hash of the case's
@@ -192,34 +231,31 @@ impl CaseStore {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(Refusal::Absent),
             Err(e) => return Err(Refusal::Unreadable(e.to_string())),
         };
-        let mut value: serde_json::Value =
+        let header: Header =
             serde_json::from_slice(&bytes).map_err(|e| Refusal::Unreadable(e.to_string()))?;
-        let object = value
-            .as_object_mut()
-            .ok_or_else(|| Refusal::Unreadable("not a JSON object".into()))?;
-        let digest = object.remove("digest");
-        if digest.is_none() && !object.contains_key("build") {
+        if header.digest.is_none() && header.build.is_none() {
             return Err(Refusal::OtherBuild(None));
         }
-        if digest.as_ref().and_then(|d| d.as_str()) != Some(case_hash(&*object).as_str()) {
+        let digest = header.digest.as_deref();
+        if digest.is_none() || content_digest(&bytes, digest).as_deref() != digest {
             return Err(Refusal::Edited("its content does not match its digest".into()));
         }
-        let stored: Stored<serde_json::Value> =
-            serde_json::from_value(value).map_err(|e| Refusal::Unreadable(e.to_string()))?;
-        if stored.id != id {
-            return Err(Refusal::Edited(format!("it holds case {:?}", stored.id)));
+        if header.id != id {
+            return Err(Refusal::Edited(format!("it holds case {:?}", header.id)));
         }
-        if stored.hash != hash {
+        if header.hash != hash {
             return Err(Refusal::OtherInputs);
         }
-        let this_build = stored
+        let this_build = header
             .build
             .as_ref()
             .is_some_and(|b| b.source == BuildId::this_build().source);
         if !this_build && !other_builds {
-            return Err(Refusal::OtherBuild(stored.build));
+            return Err(Refusal::OtherBuild(header.build));
         }
-        serde_json::from_value(stored.record).map_err(|e| Refusal::Unreadable(e.to_string()))
+        let stored: Stored<T> =
+            serde_json::from_slice(&bytes).map_err(|e| Refusal::Unreadable(e.to_string()))?;
+        Ok(stored.record)
     }
 
     /// Store the record of case `id` with its input hash, this build and the content digest,
@@ -233,13 +269,13 @@ impl CaseStore {
             digest: None,
             record,
         };
-        let mut value = serde_json::to_value(&stored).map_err(|e| StudyError::io(&path, e))?;
-        let digest = case_hash(&value);
-        if let Some(o) = value.as_object_mut() {
-            o.insert("digest".into(), digest.into());
-        }
-        let json = serde_json::to_string(&value).map_err(|e| StudyError::io(&path, e))?;
-        write_file(&path, json.as_bytes())
+        let mut text = serde_json::to_string(&stored).map_err(|e| StudyError::io(&path, e))?;
+        let digest = content_digest(text.as_bytes(), None).unwrap_or_default();
+        // The member goes where serde puts a field declared between `build` and `record`; in
+        // JSON text `,"record":` cannot occur inside a string, so its first place is the key.
+        let at = text.find(",\"record\":").unwrap_or(text.len());
+        text.insert_str(at, &digest_member(&digest));
+        write_file(&path, text.as_bytes())
     }
 }
 
@@ -288,49 +324,60 @@ mod tests {
         assert_eq!(store.load::<Vec<f64>>("c2", "00ff", false), Err(Refusal::Absent));
     }
 
-    /// `c1` stored, its file read as JSON, changed by `edit`, written back and loaded.
-    fn load_edited(
-        edit: impl Fn(&mut serde_json::Map<String, serde_json::Value>),
-        other_builds: bool,
-    ) -> Result<Vec<f64>, Refusal> {
+    /// `c1` stored, its file's text changed by `edit`, written back and loaded.
+    fn load_edited(edit: impl Fn(String) -> String, other_builds: bool) -> Result<Vec<f64>, Refusal> {
         let dir = tempfile::tempdir().unwrap();
         let store = CaseStore::open(dir.path()).unwrap();
         store.save("c1", "00ff", &vec![1.5, 2.5]).unwrap();
         let path = store.path("c1").unwrap();
-        let mut v: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
-        edit(v.as_object_mut().unwrap());
-        std::fs::write(&path, serde_json::to_string(&v).unwrap()).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&path, edit(text)).unwrap();
         store.load::<Vec<f64>>("c1", "00ff", other_builds)
     }
 
-    /// The object with `build` replaced and its digest recomputed (what another build writes).
-    fn other_build(o: &mut serde_json::Map<String, serde_json::Value>) {
-        let b = BuildId {
-            source: "0123456789abcdef".into(),
-            ..BuildId::this_build()
-        };
-        o.insert("build".into(), serde_json::to_value(b).unwrap());
-        o.remove("digest");
-        let d = case_hash(&*o);
-        o.insert("digest".into(), d.into());
+    /// `text` with `from` (which must occur) replaced by `to` and the digest recomputed as
+    /// the store computes it.
+    fn resealed(text: &str, from: &str, to: &str) -> String {
+        assert!(text.contains(from), "{from} not in {text}");
+        let old: serde_json::Value = serde_json::from_str(text).unwrap();
+        let member = format!(",\"digest\":\"{}\"", old["digest"].as_str().unwrap());
+        let bare = text.replacen(&member, "", 1).replacen(from, to, 1);
+        let digest = format!("{:016x}", fnv1a64(bare.as_bytes()));
+        bare.replacen(
+            ",\"record\":",
+            &format!(",\"digest\":\"{digest}\",\"record\":"),
+            1,
+        )
+    }
+
+    /// The file as another build writes it: another source digest, the digest recomputed.
+    fn other_build(text: String) -> String {
+        let this = format!("\"source\":\"{}\"", BuildId::this_build().source);
+        resealed(&text, &this, "\"source\":\"0123456789abcdef\"")
     }
 
     #[test]
     fn an_edited_record_is_refused_even_from_another_build() {
-        // Reformatting alone (the canonical JSON is unchanged) keeps the record.
-        assert_eq!(load_edited(|_| {}, false), Ok(vec![1.5, 2.5]));
-        let edit = |o: &mut serde_json::Map<String, serde_json::Value>| {
-            o.insert("record".into(), serde_json::json!([1.5, 1e-12]));
-        };
+        assert_eq!(load_edited(|t| t, false), Ok(vec![1.5, 2.5]));
+        // Resealing alone reproduces the file (the test's digest is the store's).
+        assert_eq!(
+            load_edited(|t| resealed(&t, "c1", "c1"), false),
+            Ok(vec![1.5, 2.5])
+        );
+        let edit = |t: String| t.replacen("2.5]", "1e-12]", 1);
         assert!(matches!(load_edited(edit, false), Err(Refusal::Edited(_))));
         assert!(matches!(load_edited(edit, true), Err(Refusal::Edited(_))));
-        let moved = |o: &mut serde_json::Map<String, serde_json::Value>| {
-            o.insert("id".into(), "c0".into());
-            o.remove("digest");
-            let d = case_hash(&*o);
-            o.insert("digest".into(), d.into());
+        // Any byte: the digest is of the file as written.
+        let spaced = |t: String| t.replacen(",", ", ", 1);
+        assert!(matches!(load_edited(spaced, false), Err(Refusal::Edited(_))));
+        let moved = |t: String| resealed(&t, "\"id\":\"c1\"", "\"id\":\"c0\"");
+        assert!(matches!(load_edited(moved, false), Err(Refusal::Edited(e)) if e.contains("c0")));
+        // The digest removed, the build kept.
+        let bare = |t: String| {
+            let v: serde_json::Value = serde_json::from_str(&t).unwrap();
+            t.replacen(&digest_member(v["digest"].as_str().unwrap()), "", 1)
         };
-        assert!(matches!(load_edited(moved, false), Err(Refusal::Edited(_))));
+        assert!(matches!(load_edited(bare, true), Err(Refusal::Edited(_))));
     }
 
     #[test]
@@ -341,9 +388,12 @@ mod tests {
         }
         assert_eq!(load_edited(other_build, true), Ok(vec![1.5, 2.5]));
         // The layout before builds were recorded: never reused, it cannot be checked.
-        let old = |o: &mut serde_json::Map<String, serde_json::Value>| {
+        let old = |t: String| {
+            let mut v: serde_json::Value = serde_json::from_str(&t).unwrap();
+            let o = v.as_object_mut().unwrap();
             o.remove("build");
             o.remove("digest");
+            serde_json::to_string(&v).unwrap()
         };
         assert_eq!(load_edited(old, false), Err(Refusal::OtherBuild(None)));
         assert_eq!(load_edited(old, true), Err(Refusal::OtherBuild(None)));
@@ -356,12 +406,14 @@ mod tests {
         store.save("c1", "00ff", &vec![1.5, 2.5]).unwrap();
         let path = store.path("c1").unwrap();
         let bytes = std::fs::read(&path).unwrap();
-        std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
+        for cut in [1, 3, bytes.len() / 2] {
+            std::fs::write(&path, &bytes[..bytes.len() - cut]).unwrap();
+            let r = store.load::<Vec<f64>>("c1", "00ff", false);
+            assert!(matches!(&r, Err(Refusal::Unreadable(_))), "cut {cut}: {r:?}");
+        }
+        std::fs::write(&path, b"").unwrap();
         let r = store.load::<Vec<f64>>("c1", "00ff", false);
-        assert!(
-            matches!(&r, Err(Refusal::Unreadable(e)) if e.contains("EOF")),
-            "{r:?}"
-        );
+        assert!(matches!(&r, Err(Refusal::Unreadable(_))), "empty: {r:?}");
     }
 
     /// This build's identity is the 16 hex digits build.rs writes.

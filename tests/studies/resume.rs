@@ -6,7 +6,7 @@
 
 use igimp::study::column::records::ColumnResults;
 use igimp::study::results::read_results;
-use igimp::study::store::case_hash;
+use igimp::study::store::fnv1a64;
 use serde_json::Value;
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -115,18 +115,29 @@ fn plant(record: &mut Value, value: f64) {
     record["record"]["output"][0]["stress_error"] = value.into();
 }
 
-/// A record as another build would have written it: its build identity replaced and its
-/// content digest recomputed the way the store computes it (the canonical hash of the stored
-/// object without its `digest`), so that only the build differs.
-fn from_other_build(record: &mut Value) {
-    let o = record.as_object_mut().unwrap();
-    o.insert(
-        "build".into(),
-        serde_json::json!({"source": "0123456789abcdef", "commit": "0000000", "dirty": false}),
-    );
-    o.remove("digest");
-    let digest = case_hash(&*o);
-    o.insert("digest".into(), digest.into());
+/// The case file's text as another build would have written it, with `stress_error` set to
+/// `value`: its source digest replaced and its content digest recomputed the way the store
+/// computes it (FNV-1a of the file without its `digest` member), so that only the build and
+/// the value differ.
+fn from_other_build(text: &str, value: f64) -> String {
+    let v: Value = serde_json::from_str(text).unwrap();
+    let member = format!(",\"digest\":\"{}\"", v["digest"].as_str().unwrap());
+    let this = format!("\"source\":\"{}\"", v["build"]["source"].as_str().unwrap());
+    assert!(text.contains(&member) && text.contains(&this), "{text}");
+    let bare = text
+        .replacen(&member, "", 1)
+        .replacen(&this, "\"source\":\"0123456789abcdef\"", 1);
+    // The outcome comes first in the record, before any point.
+    let key = "\"stress_error\":";
+    let at = bare.find(key).unwrap() + key.len();
+    let end = at + bare[at..].find([',', '}']).unwrap();
+    let bare = format!("{}{value:e}{}", &bare[..at], &bare[end..]);
+    let digest = format!("{:016x}", fnv1a64(bare.as_bytes()));
+    bare.replacen(
+        ",\"record\":",
+        &format!(",\"digest\":\"{digest}\",\"record\":"),
+        1,
+    )
 }
 
 /// (resumed, total) of the "resumed N of M cases" line.
@@ -194,16 +205,15 @@ fn a_truncated_record_is_solved_again_and_said() {
 fn a_record_of_another_build_is_solved_again_unless_asked() {
     let s = Setup::solved();
     let first = s.results();
-    let mut other = s.record();
-    plant(&mut other, PLANTED);
-    from_other_build(&mut other);
-    s.put_record(&other);
+    let text = std::fs::read_to_string(s.record_file()).unwrap();
+    let other = from_other_build(&text, PLANTED);
+    std::fs::write(s.record_file(), &other).unwrap();
     let err = s.ok(&["--resume"]);
     said(&err, "another build");
     assert_eq!(resumed(&err), (2, 3), "{err}");
     assert_eq!(s.results().without_timing(), first.without_timing());
 
-    s.put_record(&other);
+    std::fs::write(s.record_file(), &other).unwrap();
     let err = s.ok(&["--resume", "--reuse-other-builds"]);
     assert_eq!(resumed(&err), (3, 3), "{err}");
     assert_eq!(stress_error(&s.results()), PLANTED);
@@ -230,9 +240,9 @@ fn merge_refuses_a_record_of_another_build_unless_asked() {
     for k in ["0/2", "1/2"] {
         s.ok(&["--shard", k]);
     }
-    let mut r = s.record();
-    from_other_build(&mut r);
-    s.put_record(&r);
+    let text = std::fs::read_to_string(s.record_file()).unwrap();
+    let value = stress_error(&first);
+    std::fs::write(s.record_file(), from_other_build(&text, value)).unwrap();
     let (out, err) = s.run(&["--merge"]);
     assert!(!out.status.success(), "merged a record of another build:\n{err}");
     assert!(
