@@ -9,6 +9,7 @@ use igimp::kinds;
 use igimp::study::checks::{check_counts, CheckRecord};
 use igimp::study::engine::RunOptions;
 use igimp::study::results::{read_json, CaseStatus, Failures};
+use igimp::study::store::Refusal;
 use igimp::study::vtk_output::VtkOptions;
 use igimp::study::{study_files, Distribution, StudyError, Tier};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -51,9 +52,16 @@ struct Cli {
     #[arg(long)]
     check: bool,
     /// Reuse the cases an earlier (e.g. interrupted) run finished with the same inputs
-    /// (`<out>/<name>/cases/`, keyed by a hash of each case's definition); solve the rest.
+    /// (`<out>/<name>/cases/`, keyed by a hash of each case's definition) and the same build;
+    /// solve the rest. A record edited, truncated, of other inputs or of another build is
+    /// solved again, and a line on stderr says which and why.
     #[arg(long)]
     resume: bool,
+    /// With --resume or --merge, also reuse records written by another build (other
+    /// sources: other solver code may give other answers). Their inputs must match and
+    /// their content must match its digest all the same.
+    #[arg(long)]
+    reuse_other_builds: bool,
     /// Write ParaView files `<out>/<name>/vtk/<case>.pvd` of the initial and the final state:
     /// column and column-3d, the material/Gauss points and the grid/mesh of every case;
     /// compaction, cantilever and manufactured (2D and 3D), the material point domains
@@ -177,6 +185,16 @@ impl Progress {
         }
     }
 
+    /// A stored record not reused: one line, whatever the output.
+    fn on_refused(&self, id: &str, why: &Refusal) {
+        let line = format!("{}: case {id} not reused, solving it again: {why}", self.label);
+        if self.terminal {
+            self.bar.println(line);
+        } else {
+            eprintln!("{line}");
+        }
+    }
+
     fn on_done(&self, id: &str, status: CaseStatus) {
         let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
         s.1 += 1;
@@ -228,15 +246,18 @@ fn run_one(file: &Path, cli: &Cli) -> Result<bool, StudyError> {
     let progress = Progress::new(label.clone());
     let on_start = |n: usize| progress.on_start(n);
     let on_done = |id: &str, status: CaseStatus| progress.on_done(id, status);
+    let on_refused = |id: &str, why: &Refusal| progress.on_refused(id, why);
     let options = RunOptions {
         study_dir: None,
         resume: cli.resume,
+        reuse_other_builds: cli.reuse_other_builds,
         vtk: (cli.vtk || cli.vtk_every.is_some()).then(|| VtkOptions {
             every: cli.vtk_every.map_or(0, |n| n as usize),
         }),
         distribution: cli.distribution(),
         on_start: &on_start,
         on_done: &on_done,
+        on_refused: &on_refused,
     };
     let ran = kinds::run_file(file, tier, &cli.out, cli.render_only, options);
     progress.bar.finish_and_clear();

@@ -3,7 +3,7 @@
 //! does the rest for every kind alike: rayon across cases (most expensive first, results in
 //! the deterministic case order, so the output does not depend on the thread count), the case
 //! store (`<out>/<name>/cases/`, every finished case written atomically as soon as it is done),
-//! `--resume` by input hash, `--vtk`, the progress callbacks, `--shard K/N` and `--merge`, and
+//! `--resume` by input hash, build and content digest ([`super::store`]), `--vtk`, the progress callbacks, `--shard K/N` and `--merge`, and
 //! the [`Envelope`] written as `results.json`.
 //!
 //! A failed case is recorded in its record (status, step, reason, residuals) and the others go
@@ -13,7 +13,7 @@ use super::checks::CheckRecord;
 use super::results::{
     read_results, write_json, CaseRecordOf, CaseStatus, Envelope, Provenance, SweepIndex, Timing,
 };
-use super::store::CaseStore;
+use super::store::{CaseStore, Refusal};
 use super::vtk_output::{pvd_path, VtkOptions};
 use super::{Distribution, StudyError, Tier};
 use crate::method::Method;
@@ -239,8 +239,12 @@ pub struct Run<K: StudyKind> {
 pub struct RunOptions<'a> {
     /// The study's output folder; `None`: no case store and no VTK (an in-memory run).
     pub study_dir: Option<PathBuf>,
-    /// Reuse the stored record of a case whose inputs hash equally.
+    /// Reuse the stored record of a case whose inputs hash equally, written by this build,
+    /// whose content matches its digest.
     pub resume: bool,
+    /// With `resume` or `--merge`, reuse records of another build too (their inputs and
+    /// content digest must still match).
+    pub reuse_other_builds: bool,
     /// Write ParaView files of the cases that have them.
     pub vtk: Option<VtkOptions>,
     /// `--shard K/N` or `--merge` (needs `study_dir`).
@@ -248,6 +252,9 @@ pub struct RunOptions<'a> {
     /// Called once with the number of cases, then with each case's id and status when done.
     pub on_start: &'a (dyn Fn(usize) + Sync),
     pub on_done: &'a (dyn Fn(&str, CaseStatus) + Sync),
+    /// Called with a case's id and the reason when its stored record is not reused and the
+    /// case is solved again (`--merge` lists them in its error instead).
+    pub on_refused: &'a (dyn Fn(&str, &Refusal) + Sync),
 }
 
 impl Default for RunOptions<'_> {
@@ -255,10 +262,12 @@ impl Default for RunOptions<'_> {
         Self {
             study_dir: None,
             resume: false,
+            reuse_other_builds: false,
             vtk: None,
             distribution: Distribution::Whole,
             on_start: &|_| {},
             on_done: &|_, _| {},
+            on_refused: &|_, _| {},
         }
     }
 }
@@ -314,11 +323,13 @@ type Solved<K> = (Vec<(<K as StudyKind>::Output, f64, Option<CaseCost>)>, usize)
 type Finished<K> = (<K as StudyKind>::Output, Option<(f64, Option<CaseCost>)>);
 
 /// Solve (or read back) every case this process owns: with `resume` (or `--merge`), a case
-/// stored earlier under the same id and input hash (with `--vtk`, whose `.pvd` exists too) is
-/// read back instead of solved; every solved case is stored as soon as it is done. Returns
-/// the outputs in case order with their seconds, and how many were resumed. `--merge` solves
-/// nothing and lists every case not in the store in one error; `--shard` stores its cases and
-/// ends with [`StudyError::ShardDone`].
+/// stored earlier under the same id and input hash by this build (or any, with
+/// `reuse_other_builds`), whose content matches its digest (with `--vtk`, whose `.pvd` exists
+/// too), is read back instead of solved, and a record refused is reported (`on_refused`);
+/// every solved case is stored as soon as it is done. Returns the outputs in case order with
+/// their seconds, and how many were resumed. `--merge` solves nothing and lists every case
+/// not read back in one error, with the reason of each refused record; `--shard` stores its
+/// cases and ends with [`StudyError::ShardDone`].
 fn solve_all<K: StudyKind>(
     study: &K,
     cases: &[K::Case],
@@ -343,12 +354,12 @@ fn solve_all<K: StudyKind>(
     let outputs = run_cases(
         &own,
         |c| study.cost(c),
-        |c| -> Result<Option<Finished<K>>, StudyError> {
+        |c| -> Result<Result<Finished<K>, Refusal>, StudyError> {
             let key = study.key(c);
             let (Some(store), Some(dir)) = (&store, &options.study_dir) else {
                 let o = study.solve(c, None)?;
                 done(&key.id, &o);
-                return Ok(Some((o, None)));
+                return Ok(Ok((o, None)));
             };
             // --merge solves nothing, so it does not ask for the VTK files either.
             let vtk_done = match options.vtk {
@@ -356,14 +367,19 @@ fn solve_all<K: StudyKind>(
                 _ => true,
             };
             if resume && vtk_done {
-                if let Some(s) = store.load::<StoredCase<K::Output>>(&key.id, &key.hash) {
-                    resumed.fetch_add(1, Ordering::Relaxed);
-                    done(&key.id, &s.output);
-                    return Ok(Some((s.output, Some((s.seconds, s.cost)))));
+                match store.load::<StoredCase<K::Output>>(&key.id, &key.hash, options.reuse_other_builds) {
+                    Ok(s) => {
+                        resumed.fetch_add(1, Ordering::Relaxed);
+                        done(&key.id, &s.output);
+                        return Ok(Ok((s.output, Some((s.seconds, s.cost)))));
+                    }
+                    Err(why) if merge => return Ok(Err(why)),
+                    Err(Refusal::Absent) => {}
+                    Err(why) => (options.on_refused)(&key.id, &why),
                 }
             }
             if merge {
-                return Ok(None);
+                return Ok(Err(Refusal::Absent));
             }
             let vtk = options.vtk.filter(|_| key.has_vtk).map(|options| VtkTarget {
                 study_dir: dir.clone(),
@@ -385,16 +401,17 @@ fn solve_all<K: StudyKind>(
             };
             store.save(&key.id, &key.hash, &stored)?;
             done(&key.id, &stored.output);
-            Ok(Some((stored.output, None)))
+            Ok(Ok((stored.output, None)))
         },
     );
     let mut out = Vec::with_capacity(outputs.len());
     let mut missing = vec![];
     for (c, (r, cost)) in own.iter().zip(outputs) {
         match r? {
-            Some((o, Some((seconds, stored)))) => out.push((o, seconds, stored)),
-            Some((o, None)) => out.push((o, cost.seconds, Some(cost))),
-            None => missing.push(study.key(c).id),
+            Ok((o, Some((seconds, stored)))) => out.push((o, seconds, stored)),
+            Ok((o, None)) => out.push((o, cost.seconds, Some(cost))),
+            Err(Refusal::Absent) => missing.push(study.key(c).id),
+            Err(why) => missing.push(format!("{} ({why})", study.key(c).id)),
         }
     }
     if let (false, Some(dir)) = (missing.is_empty(), &options.study_dir) {

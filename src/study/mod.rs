@@ -82,8 +82,8 @@ pub enum StudyError {
         total: usize,
         dir: String,
     },
-    /// `--merge` with cases no shard has stored (for these inputs).
-    #[error("{dir}: --merge: {} of {total} cases not stored by any shard (or stored for other inputs): {}", missing.len(), missing.join(", "))]
+    /// `--merge` with cases no shard has stored (for these inputs, by this build).
+    #[error("{dir}: --merge: {} of {total} cases not stored by any shard (or refused, with the reason): {}", missing.len(), missing.join(", "))]
     MissingCases {
         dir: String,
         total: usize,

@@ -14,6 +14,7 @@ mod manufactured_dynamic_study;
 mod manufactured_study;
 mod performance;
 mod reliability;
+mod resume;
 mod study;
 mod three_d_studies;
 mod trimmed;
