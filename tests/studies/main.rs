@@ -13,6 +13,7 @@ mod manufactured_dynamic_study;
 mod manufactured_study;
 mod performance;
 mod reliability;
+mod schema_doc;
 mod study;
 mod three_d_studies;
 mod trimmed;
