@@ -15,6 +15,7 @@ mod manufactured_study;
 mod performance;
 mod reliability;
 mod resume;
+mod schema_doc;
 mod study;
 mod three_d_studies;
 mod trimmed;
