@@ -83,11 +83,13 @@ pub enum StudyError {
         dir: String,
     },
     /// `--merge` with cases no shard has stored (for these inputs, by this build).
-    #[error("{dir}: --merge: {} of {total} cases not stored by any shard (or refused, with the reason): {}", missing.len(), missing.join(", "))]
+    #[error("{dir}: --merge: {} of {total} cases not stored by any shard (or refused, with the reason): {}{hint}", missing.len(), missing.join(", "))]
     MissingCases {
         dir: String,
         total: usize,
         missing: Vec<String>,
+        /// Why they may be missing (e.g. the store holds another tier's cases), or empty.
+        hint: String,
     },
 }
 

@@ -367,6 +367,8 @@ impl RunSummary {
 pub struct Failures {
     pub expected: Vec<(String, String)>,
     pub unexpected: Vec<(String, CaseStatus)>,
+    /// Declared patterns that match no case of the run (stale, or of sweeps not run).
+    pub unmatched: Vec<String>,
 }
 
 impl Failures {
@@ -379,6 +381,16 @@ impl Failures {
             .unwrap_or_default();
         let mut out = Failures::default();
         let cases = results.get("cases").and_then(|c| c.as_array());
+        let ids: Vec<&str> = cases
+            .into_iter()
+            .flatten()
+            .filter_map(|c| c.get("id")?.as_str())
+            .collect();
+        for p in declared.iter().flat_map(|e| &e.cases) {
+            if !ids.iter().any(|id| super::vocabulary::glob_match(p, id)) {
+                out.unmatched.push(p.clone());
+            }
+        }
         for c in cases.into_iter().flatten() {
             let id = c.get("id").and_then(|v| v.as_str()).unwrap_or("?").to_string();
             let status = c
@@ -420,6 +432,12 @@ impl Failures {
                 "{} NOT expected: {}",
                 self.unexpected.len(),
                 ids.join(", ")
+            ));
+        }
+        if !self.unmatched.is_empty() {
+            parts.push(format!(
+                "expected failures that match no case of this run: {}",
+                self.unmatched.join(", ")
             ));
         }
         (!parts.is_empty()).then(|| parts.join("; "))

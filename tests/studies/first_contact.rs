@@ -153,7 +153,8 @@ fn a_domain_update_on_a_fem_case_is_rejected() {
     let base = repo_study("cantilever");
     let fem = base.find("method = \"fem-q8\"").expect("a Q8 case");
     let t = format!("{}domain_update = \"stretch\"\n{}", &base[..fem], &base[fem..]);
-    rejected(&t, "domain_update", "must be absent for fem-q8", None);
+    let err = rejected(&t, "cases[8].domain_update", "must be absent for fem-q8", None);
+    assert!(err.contains("= \"stretch\""), "{err}");
 }
 
 /// D8: `elements = [8, 8]` was silently de-duplicated while a duplicate method is rejected.
@@ -196,15 +197,18 @@ fn check_fails_on_undeclared_failures_and_reports_declared_ones() {
     );
 }
 
-/// A declaration that matches no case is stale, and an error.
+/// A declaration that matches no case of the run is said (stale, or of a sweep not run), and
+/// the failures it does not cover fail --check.
 #[test]
-fn an_expected_failure_matching_no_case_is_rejected() {
+fn an_expected_failure_matching_no_case_is_said() {
+    let tmp = tempfile::tempdir().unwrap();
     let t = failing_column(true).replace("cases = [\"igimp-*\"]", "cases = [\"mpm-*\"]");
-    rejected(
-        &t,
-        "expected_failures[0].cases[0]",
-        "must match the id of a case",
-        None,
+    write(tmp.path(), "tiny.toml", &t);
+    let (o, err) = study(&["tiny.toml", "--check", "--out", "out"], tmp.path());
+    assert_eq!(o.status.code(), Some(2), "stderr:\n{err}");
+    assert!(
+        err.contains("expected failures that match no case of this run: mpm-*"),
+        "{err}"
     );
 }
 
@@ -347,10 +351,7 @@ fn a_case_over_the_size_cap_is_recorded_and_the_others_run() {
             .iter()
             .find(|c| c["id"] == id)
             .unwrap_or_else(|| panic!("no case {id}"));
-        (
-            c["solve"]["status"].clone(),
-            c["solve"]["failure"]["reason"].clone(),
-        )
+        (c["status"].clone(), c["failure"]["reason"].clone())
     };
     let (s, reason) = status("fem-q4-elastic-h0.0001");
     assert_eq!(s, "rejected");
@@ -359,4 +360,23 @@ fn a_case_over_the_size_cap_is_recorded_and_the_others_run() {
         "{reason}"
     );
     assert_eq!(status("fem-q4-elastic-h2").0, "converged");
+}
+
+/// D9: a `--merge` of another tier than its shards' listed every case "missing" with no hint.
+#[test]
+fn a_merge_of_another_tier_says_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = failing_column(true).replace(
+        "points_per_cell = [2]\n",
+        "points_per_cell = [2]\nquick = { elements = [16] }\n",
+    );
+    write(tmp.path(), "tiny.toml", &text);
+    let (o, err) = study(
+        &["tiny.toml", "--quick", "--shard", "0/1", "--out", "out"],
+        tmp.path(),
+    );
+    assert!(o.status.success(), "{err}");
+    let (o, err) = study(&["tiny.toml", "--merge", "--out", "out"], tmp.path());
+    assert!(!o.status.success(), "{err}");
+    assert!(err.contains("another tier (--quick)"), "{err}");
 }

@@ -55,7 +55,7 @@ impl CantileverStudy {
             if let (Some(u), false) = (c.domain_update, c.method.uses_domain_update()) {
                 return Err(chk.err(
                     format!("cases[{i}].domain_update"),
-                    format!("{u:?}"),
+                    serde_json::to_string(&u).unwrap_or_default(),
                     format!(
                         "must be absent for {}: only the domain-averaged families (e.g. igimp) update point domains",
                         c.method.name()
