@@ -1,12 +1,73 @@
 //! SVG figures (plotters, SVG backend only).
 //!
 //! plotters is built without its `ttf` feature, so no system font is loaded: text is written
-//! as SVG `<text>` in the generic `sans-serif` family and the viewer picks the face. Layout uses
-//! plotters' naive text-size estimate, so every font size here is explicit and generous
-//! margins leave room for labels. The output is a pure function of the input data, which is
-//! what makes `study --render-only` byte-identical.
+//! as SVG `<text>` in the generic `sans-serif` family and the viewer picks the face. Every font
+//! size is explicit, and the layout ([`layout`]: ticks, titles, legend place) estimates text
+//! extents from character counts, the way tests/studies/figures.rs checks them. Text from a
+//! study file is made XML-safe ([`svg_text`]) before plotters escapes it. The output is a pure
+//! function of the input data, which is what makes `study --render-only` byte-identical.
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+mod convergence;
+mod layout;
+pub use convergence::{convergence_svg, convergence_svg_along};
+pub(crate) use layout::{at_fraction, fraction, place_legend, svg_text, ticks, title_layout, Corner};
+
+/// A linear or logarithmic axis from `lo` to `hi` marked at the ticks [`layout::ticks`] chose
+/// (plotters' own log axis puts a key point at every integer multiple, each decade twice, and
+/// none inside a range under a decade; its `with_key_points` loses the f64 label formatter).
+/// One type for both scales, so that a chart's drawing code does not depend on them.
+pub(crate) struct TickedAxis {
+    lo: f64,
+    hi: f64,
+    log: bool,
+    pub ticks: layout::Ticks,
+}
+
+impl TickedAxis {
+    /// The axis over `pixels`, its labels side by side (`horizontal`) or stacked.
+    pub fn new(lo: f64, hi: f64, log: bool, pixels: f64, horizontal: bool) -> Self {
+        TickedAxis {
+            lo,
+            hi,
+            log,
+            ticks: ticks(lo, hi, log, pixels, horizontal, TICK_PT),
+        }
+    }
+}
+
+impl Ranged for TickedAxis {
+    type FormatOption = plotters::coord::ranged1d::DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        // As plotters maps a linear axis, in the axis's fraction; off-scale values (a log
+        // axis's zero) go to the nearer end.
+        let f = fraction(*value, self.lo, self.hi, self.log);
+        let f = if f.is_finite() { f.clamp(-10.0, 10.0) } else { 0.0 };
+        let length = limit.1 - limit.0;
+        if length >= 0 {
+            limit.0 + (length as f64 * f + 1e-3).floor() as i32
+        } else {
+            limit.0 + (length as f64 * f - 1e-3).ceil() as i32
+        }
+    }
+
+    fn key_points<Hint: plotters::coord::ranged1d::KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            vec![]
+        } else {
+            self.ticks.values.clone()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.lo..self.hi
+    }
+}
 
 /// Figure size in pixels.
 pub(crate) const SIZE: (u32, u32) = (900, 640);
@@ -15,6 +76,15 @@ pub(crate) const CAPTION_PT: u32 = 24;
 pub(crate) const AXIS_DESC_PT: u32 = 20;
 pub(crate) const TICK_PT: u32 = 16;
 pub(crate) const LEGEND_PT: u32 = 16;
+/// Margin around a chart, and the heights of the x tick-and-description area.
+pub(crate) const MARGIN: u32 = 20;
+pub(crate) const X_LABEL_AREA: u32 = 60;
+/// The most series a figure tells apart: every colour with every marker (7 × 4, the pairs
+/// `(i mod 7, i mod 4)` differ for i below 28). Further series are drawn in grey under one
+/// legend entry.
+pub(crate) const MAX_SERIES: usize = 28;
+/// The colour of the series beyond [`MAX_SERIES`].
+pub(crate) const GREY: RGBColor = RGBColor(150, 150, 150);
 
 /// Series colours (colour-blind safe, Okabe–Ito).
 const PALETTE: [RGBColor; 7] = [
@@ -65,7 +135,94 @@ pub(crate) fn err<E: std::fmt::Display>(e: E) -> String {
 }
 
 pub(crate) fn color(i: usize) -> RGBColor {
+    if i >= MAX_SERIES {
+        return GREY;
+    }
     PALETTE[i % PALETTE.len()]
+}
+
+/// Whether series `i` of lines without markers is dashed: the second seven lines repeat the
+/// colours of the first seven, dashed, so that no two look alike.
+pub(crate) fn dashed(i: usize) -> bool {
+    (i / PALETTE.len()) % 2 == 1
+}
+
+/// Label of series `i` of `n` in the legend: its own below [`MAX_SERIES`]; the first grey
+/// series stands for all of them; the rest have none.
+pub(crate) fn legend_label(i: usize, n: usize, label: &str) -> Option<String> {
+    match i.cmp(&MAX_SERIES) {
+        std::cmp::Ordering::Less => Some(svg_text(label)),
+        std::cmp::Ordering::Equal => Some(format!("{} more series (grey)", n - MAX_SERIES)),
+        std::cmp::Ordering::Greater => None,
+    }
+}
+
+/// Draw `title` (XML-safe, fitted to the width: [`title_layout`]) centred at the top of
+/// `root` and return the area below it.
+pub(crate) fn titled<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+) -> PlotResult<DrawingArea<DB, Shift>> {
+    titled_at(root, title, CAPTION_PT)
+}
+
+/// [`titled`] at `pt` (the colour bar's caption).
+pub(crate) fn titled_at<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    pt: u32,
+) -> PlotResult<DrawingArea<DB, Shift>> {
+    let (w, _) = root.dim_in_pixel();
+    let t = title_layout(title, pt, w as f64 - 20.0);
+    for (i, line) in t.lines.iter().enumerate() {
+        let style = TextStyle::from((FONT, t.pt).into_font()).pos(Pos::new(HPos::Center, VPos::Top));
+        let y = 10 + (i as f64 * 1.25 * t.pt as f64).round() as i32;
+        root.draw(&Text::new(line.clone(), (w as i32 / 2, y), style))
+            .map_err(err)?;
+    }
+    Ok(root.split_vertically(t.height()).1)
+}
+
+/// The plot area's size in pixels of a chart drawn on `area` with the figures' margin, x label
+/// area and a y label area of `y_area` pixels.
+pub(crate) fn plot_size<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, y_area: u32) -> (f64, f64) {
+    let (w, h) = area.dim_in_pixel();
+    (
+        w.saturating_sub(2 * MARGIN + y_area) as f64,
+        h.saturating_sub(2 * MARGIN + X_LABEL_AREA) as f64,
+    )
+}
+
+/// The chart builder of every figure: margins and label areas, no caption ([`titled`]).
+pub(crate) fn chart_on<'a, 'b, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    y_area: u32,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut b = ChartBuilder::on(area);
+    b.margin(MARGIN)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(y_area);
+    b
+}
+
+/// Where the legend of `labels` goes on a plot of `size` pixels, given the data in plot
+/// fractions (see [`place_legend`]): its position and the y range's new fractions.
+pub(crate) fn legend_place(
+    labels: &[String],
+    points: &[(f64, f64)],
+    lines: &[Vec<(f64, f64)>],
+    size: (f64, f64),
+    preferred: Corner,
+) -> (SeriesLabelPosition, (f64, f64)) {
+    let legend = layout::legend_size(labels, LEGEND_PT);
+    let (c, range) = place_legend(points, lines, legend, size, preferred);
+    let at = match c {
+        Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
+        Corner::UpperRight => SeriesLabelPosition::UpperRight,
+        Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
+        Corner::LowerRight => SeriesLabelPosition::LowerRight,
+    };
+    (at, range)
 }
 
 pub(crate) fn draw_markers<
@@ -78,7 +235,7 @@ pub(crate) fn draw_markers<
     points: &[(f64, f64)],
     marker: Marker,
     col: RGBColor,
-    label: &str,
+    label: Option<&str>,
     line: bool,
 ) -> PlotResult<()> {
     let size = 5;
@@ -106,6 +263,9 @@ pub(crate) fn draw_markers<
             .draw_series(points.iter().map(|&p| Cross::new(p, size, col.stroke_width(2))))
             .map_err(err)?,
     };
+    let Some(label) = label else {
+        return Ok(());
+    };
     // Legend entry: a short line (for line series) and the marker, offsets relative to the
     // entry's anchor.
     let seg = if line {
@@ -114,7 +274,7 @@ pub(crate) fn draw_markers<
         vec![(12, 0), (12, 0)]
     };
     let line_style = col.stroke_width(2);
-    let anno = anno.label(label);
+    let anno = anno.label(svg_text(label));
     match marker {
         Marker::Circle => anno.legend(move |(x, y)| {
             EmptyElement::at((x, y))
@@ -172,7 +332,7 @@ pub fn profile_svg(
     let all = series.iter().chain(analytical).flat_map(|s| s.points.iter());
     let (mut x0, mut x1, mut y0, mut y1) =
         (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
-    for &(x, y) in all {
+    for &(x, y) in all.filter(|p| p.0.is_finite() && p.1.is_finite()) {
         x0 = x0.min(x);
         x1 = x1.max(x);
         y0 = y0.min(y);
@@ -183,27 +343,43 @@ pub fn profile_svg(
     }
     let (x0, x1) = padded(x0, x1, 0.04);
     let (y0, y1) = padded(y0, y1, 0.04);
+    let y_area = 90;
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, (FONT, CAPTION_PT))
-            .margin(20)
-            .x_label_area_size(60)
-            .y_label_area_size(90)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(err)?;
+        let area = titled(&root, title)?;
+        let size = plot_size(&area, y_area);
+        let frac = |p: &(f64, f64)| (fraction(p.0, x0, x1, false), fraction(p.1, y0, y1, false));
+        let labels: Vec<String> = analytical
+            .iter()
+            .map(|c| svg_text(&c.label))
+            .chain(
+                series
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, s)| legend_label(i, series.len(), &s.label)),
+            )
+            .collect();
+        let points: Vec<(f64, f64)> = series.iter().flat_map(|s| s.points.iter().map(frac)).collect();
+        let lines: Vec<Vec<(f64, f64)>> = analytical
+            .iter()
+            .map(|c| c.points.iter().map(frac).collect())
+            .collect();
+        let (at, (f0, f1)) = legend_place(&labels, &points, &lines, size, Corner::UpperLeft);
+        let (y0, y1) = (at_fraction(f0, y0, y1, false), at_fraction(f1, y0, y1, false));
+        let xt = TickedAxis::new(x0, x1, false, size.0, true);
+        let yt = TickedAxis::new(y0, y1, false, size.1, false);
+        let (xl, yl) = (xt.ticks.clone(), yt.ticks.clone());
+        let mut chart = chart_on(&area, y_area).build_cartesian_2d(xt, yt).map_err(err)?;
         chart
             .configure_mesh()
-            .x_desc(x_desc)
-            .y_desc(y_desc)
+            .x_desc(svg_text(x_desc))
+            .y_desc(svg_text(y_desc))
             .axis_desc_style((FONT, AXIS_DESC_PT))
             .label_style((FONT, TICK_PT))
-            .x_labels(8)
-            .y_labels(8)
-            .x_label_formatter(&|v| format!("{v:.0}"))
-            .y_label_formatter(&|v| format!("{v:.0}"))
+            .x_label_formatter(&|v| xl.label(*v))
+            .y_label_formatter(&|v| yl.label(*v))
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(err)?;
@@ -216,209 +392,22 @@ pub fn profile_svg(
             chart
                 .draw_series(LineSeries::new(curve.points.iter().copied(), style))
                 .map_err(err)?
-                .label(curve.label.as_str())
+                .label(svg_text(&curve.label))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
         }
         for (i, s) in series.iter().enumerate() {
-            draw_markers(&mut chart, &s.points, Marker::nth(i), color(i), &s.label, false)?;
+            let label = legend_label(i, series.len(), &s.label);
+            draw_markers(
+                &mut chart,
+                &s.points,
+                Marker::nth(i),
+                color(i),
+                label.as_deref(),
+                false,
+            )?;
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+        draw_legend(&mut chart, at)?;
         root.present().map_err(err)?;
     }
     Ok(svg)
-}
-
-/// Error against element count on log-log axes, one series each, optionally with a slope
-/// triangle under the finest segment of each series.
-pub fn convergence_svg(
-    title: &str,
-    y_desc: &str,
-    series: &[ConvergenceSeries],
-    slope_triangles: bool,
-) -> PlotResult<String> {
-    convergence_svg_along(title, "number of elements", y_desc, series, slope_triangles)
-}
-
-/// A log axis's tick label only at 1, 2 and 5 times a power of ten: plotters puts a key point
-/// at every integer multiple, whose labels run together near each decade ("90100").
-fn log_tick(v: f64, label: String) -> String {
-    if !(v > 0.0 && v.is_finite()) {
-        return label;
-    }
-    let mantissa = v / 10f64.powf(v.log10().floor());
-    if [1.0, 2.0, 5.0, 10.0].iter().any(|m| (mantissa - m).abs() < 1e-6) {
-        label
-    } else {
-        String::new()
-    }
-}
-
-/// Where each slope triangle's label goes: under its triangle, moved down past any earlier
-/// label it would overlap (triangles of several series share the finest segment, so their
-/// labels fell on one another).
-fn slope_label_positions(triangles: &[Option<[(f64, f64); 3]>]) -> Vec<Option<(f64, f64)>> {
-    // A label is about 1/30 of the plot's height; in log units of y the triangles' own
-    // spacing is the scale, so two labels closer than a factor 1.6 in y (and 1.3 in x)
-    // are taken to overlap, and a label moves down by a factor 1.8 at a time.
-    let mut out: Vec<Option<(f64, f64)>> = vec![];
-    for t in triangles {
-        let Some(t) = t else {
-            out.push(None);
-            continue;
-        };
-        let mut p = ((t[0].0 * t[1].0).sqrt(), t[2].1 / 1.25);
-        let overlaps = |p: (f64, f64), q: (f64, f64)| {
-            (p.0 / q.0).ln().abs() < 1.3f64.ln() && (p.1 / q.1).ln().abs() < 1.6f64.ln()
-        };
-        for _ in 0..triangles.len() {
-            if !out.iter().flatten().any(|&q| overlaps(p, q)) {
-                break;
-            }
-            p.1 /= 1.8;
-        }
-        out.push(Some(p));
-    }
-    out
-}
-
-/// [`convergence_svg`] with the x axis described by `x_desc` (e.g. elements per side).
-pub fn convergence_svg_along(
-    title: &str,
-    x_desc: &str,
-    y_desc: &str,
-    series: &[ConvergenceSeries],
-    slope_triangles: bool,
-) -> PlotResult<String> {
-    // Triangles under the finest segment: the hypotenuse has the fitted slope, the right angle
-    // is at the bottom left, the top vertex at 0.45× the error of the second-finest point.
-    let triangles: Vec<Option<[(f64, f64); 3]>> = series
-        .iter()
-        .map(|s| {
-            let n = s.points.len();
-            let slope = s.slope?;
-            if !slope_triangles || n < 2 {
-                return None;
-            }
-            let (na, ea) = s.points[n - 2];
-            let (nb, _) = s.points[n - 1];
-            let top = 0.45 * ea;
-            let bottom = top * (na / nb).powf(slope);
-            Some([(na, top), (nb, bottom), (na, bottom)])
-        })
-        .collect();
-    let labels = slope_label_positions(&triangles);
-    let all = series
-        .iter()
-        .flat_map(|s| s.points.iter().copied())
-        .chain(triangles.iter().flatten().flat_map(|t| t.iter().copied()))
-        .chain(triangles.iter().flatten().map(|t| (t[0].0, t[2].1 / 2.0)))
-        .chain(labels.iter().flatten().map(|&(x, y)| (x, y / 1.6)));
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
-    for (x, y) in all {
-        if x > 0.0 && y > 0.0 {
-            x0 = x0.min(x);
-            x1 = x1.max(x);
-            y0 = y0.min(y);
-            y1 = y1.max(y);
-        }
-    }
-    if !(x0.is_finite() && y0.is_finite()) {
-        return Err("convergence figure without positive data".into());
-    }
-    let (x0, x1) = (x0 / 1.5, x1 * 1.5);
-    let (y0, y1) = (y0 / 2.5, y1 * 2.5);
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE).map_err(err)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, (FONT, CAPTION_PT))
-            .margin(20)
-            .x_label_area_size(60)
-            .y_label_area_size(100)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_desc)
-            .y_desc(y_desc)
-            .axis_desc_style((FONT, AXIS_DESC_PT))
-            .label_style((FONT, TICK_PT))
-            .x_label_formatter(&|v| log_tick(*v, format!("{v:.0}")))
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(err)?;
-        for (i, s) in series.iter().enumerate() {
-            let pts: Vec<(f64, f64)> = s
-                .points
-                .iter()
-                .copied()
-                .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-                .collect();
-            let label = match s.slope {
-                Some(k) => format!("{} (slope {k:.2})", s.label),
-                None => s.label.clone(),
-            };
-            draw_markers(&mut chart, &pts, Marker::nth(i), color(i), &label, true)?;
-            if let (Some(t), Some(k)) = (triangles[i], s.slope) {
-                let col = color(i);
-                chart
-                    .draw_series(std::iter::once(PathElement::new(
-                        vec![t[0], t[1], t[2], t[0]],
-                        col.stroke_width(1),
-                    )))
-                    .map_err(err)?;
-                let mid = labels[i].unwrap_or(((t[0].0 * t[1].0).sqrt(), t[2].1 / 1.25));
-                chart
-                    .draw_series(std::iter::once(Text::new(
-                        format!("{k:.2}"),
-                        mid,
-                        (FONT, TICK_PT).into_font().color(&col),
-                    )))
-                    .map_err(err)?;
-            }
-        }
-        draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
-        root.present().map_err(err)?;
-    }
-    Ok(svg)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Three series whose finest segments coincide (the manufactured vortex: slopes 1.41, 1.41
-    /// and 1.20 drawn at one spot before, 2026-12-03): every pair of labels ends at least a
-    /// factor 1.6 apart in y, and a lone label stays under its own triangle.
-    #[test]
-    fn slope_labels_do_not_overlap() {
-        let t = |top: f64, slope: f64| {
-            let bottom = top * (32.0f64 / 64.0).powf(slope);
-            Some([(32.0, top), (64.0, bottom), (32.0, bottom)])
-        };
-        let tri = vec![t(0.01, 1.41), t(0.01, 1.41), t(0.0105, 1.20), None];
-        let p = slope_label_positions(&tri);
-        assert!(p[3].is_none());
-        let ys: Vec<f64> = p.iter().flatten().map(|q| q.1).collect();
-        for i in 0..ys.len() {
-            for j in 0..i {
-                assert!((ys[i] / ys[j]).ln().abs() >= 1.6f64.ln() - 1e-12, "{ys:?}");
-            }
-        }
-        let lone = slope_label_positions(&[t(0.01, 2.0)]);
-        let want = t(0.01, 2.0).unwrap()[2].1 / 1.25;
-        assert_eq!(lone[0].unwrap().1, want);
-    }
-
-    /// Log-axis ticks are labelled at 1, 2 and 5 per decade only.
-    #[test]
-    fn log_ticks_at_one_two_five() {
-        let shown: Vec<f64> = [10.0, 20.0, 30.0, 50.0, 90.0, 100.0, 200.0, 400.0]
-            .into_iter()
-            .filter(|&v| !log_tick(v, format!("{v:.0}")).is_empty())
-            .collect();
-        assert_eq!(shown, [10.0, 20.0, 50.0, 100.0, 200.0]);
-    }
 }

@@ -7,8 +7,9 @@
 //! function of the data so that `study --render-only` is byte-identical.
 
 use crate::plot::{
-    color, draw_legend, draw_markers, err, padded, Marker, PlotResult, AXIS_DESC_PT, CAPTION_PT, FONT, SIZE,
-    TICK_PT,
+    at_fraction, chart_on, color, dashed, draw_legend, draw_markers, err, fraction, legend_label,
+    legend_place, padded, plot_size, svg_text, titled, titled_at, Corner, Marker, PlotResult, TickedAxis,
+    AXIS_DESC_PT, FONT, SIZE, TICK_PT,
 };
 use plotters::prelude::*;
 
@@ -91,39 +92,67 @@ pub fn domains_svg(
     let (x0, x1) = range_of(corners.iter().map(|c| c.0)).ok_or("domain figure without data")?;
     let (y0, y1) = range_of(corners.iter().map(|c| c.1)).ok_or("domain figure without data")?;
     let value_range = range_of(layers.iter().flat_map(|l| l.values.iter().flatten().copied()));
-    // Plot area in pixels (figure minus colour bar, margins and label areas), then pad the
-    // shorter data range so one unit is the same length along x and y.
     let bar_width = if value_range.is_some() { 150 } else { 0 };
-    let (w, h) = (
-        (SIZE.0 - bar_width - 40 - 70) as f64,
-        (SIZE.1 - 40 - 60 - 40) as f64,
-    );
+    let y_area = 70;
     let (x0, x1) = padded(x0, x1, 0.03);
     let (y0, y1) = padded(y0, y1, 0.03);
-    let scale = ((x1 - x0) / w).max((y1 - y0) / h);
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let (x0, x1) = (cx - 0.5 * scale * w, cx + 0.5 * scale * w);
-    let (y0, y1) = (cy - 0.5 * scale * h, cy + 0.5 * scale * h);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let root = root.titled(title, (FONT, CAPTION_PT)).map_err(err)?;
-        let (left, right) = root.split_horizontally(SIZE.0 - bar_width);
-        let mut chart = ChartBuilder::on(&left)
-            .margin(20)
-            .x_label_area_size(60)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(err)?;
+        let area = titled(&root, title)?;
+        let (left, right) = area.split_horizontally(SIZE.0 - bar_width);
+        // Pad the shorter data range so that one unit is the same length along x and y.
+        let (w, h) = plot_size(&left, y_area);
+        let scale = ((x1 - x0) / w).max((y1 - y0) / h);
+        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        let (mut x0, mut x1) = (cx - 0.5 * scale * w, cx + 0.5 * scale * w);
+        let (mut y0, mut y1) = (cy - 0.5 * scale * h, cy + 0.5 * scale * h);
+        // The legend (outlined layers and marks) goes in a corner clear of every domain, or
+        // in a band the ranges are stretched by, equally along x and y.
+        let labels: Vec<String> = layers
+            .iter()
+            .filter(|l| l.values.is_none() && !l.label.is_empty())
+            .map(|l| svg_text(&l.label))
+            .chain(marks.iter().map(|m| svg_text(&m.label)))
+            .collect();
+        let frac = |p: (f64, f64)| (fraction(p.0, x0, x1, false), fraction(p.1, y0, y1, false));
+        let outlines: Vec<Vec<(f64, f64)>> = layers
+            .iter()
+            .flat_map(|l| l.domains.iter())
+            .map(|d| {
+                let [a, b] = d.corners();
+                [a, (b.0, a.1), b, (a.0, b.1), a].map(frac).to_vec()
+            })
+            .collect();
+        let points: Vec<(f64, f64)> = marks
+            .iter()
+            .flat_map(|m| m.points.iter().copied())
+            .chain(
+                layers
+                    .iter()
+                    .flat_map(|l| l.domains.iter().map(|d| (d.centre[0], d.centre[1]))),
+            )
+            .map(frac)
+            .collect();
+        let (at, (f0, f1)) = legend_place(&labels, &points, &outlines, (w, h), Corner::UpperRight);
+        if (f0, f1) != (0.0, 1.0) {
+            let s = f1 - f0;
+            (y0, y1) = (at_fraction(f0, y0, y1, false), at_fraction(f1, y0, y1, false));
+            (x0, x1) = (cx - 0.5 * s * (x1 - x0), cx + 0.5 * s * (x1 - x0));
+        }
+        let xt = TickedAxis::new(x0, x1, false, w, true);
+        let yt = TickedAxis::new(y0, y1, false, h, false);
+        let (xl, yl) = (xt.ticks.clone(), yt.ticks.clone());
+        let mut chart = chart_on(&left, y_area).build_cartesian_2d(xt, yt).map_err(err)?;
         chart
             .configure_mesh()
-            .x_desc(axes.0)
-            .y_desc(axes.1)
+            .x_desc(svg_text(axes.0))
+            .y_desc(svg_text(axes.1))
             .axis_desc_style((FONT, AXIS_DESC_PT))
             .label_style((FONT, TICK_PT))
-            .x_label_formatter(&|v| format!("{v:.1}"))
-            .y_label_formatter(&|v| format!("{v:.1}"))
+            .x_label_formatter(&|v| xl.label(*v))
+            .y_label_formatter(&|v| yl.label(*v))
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(err)?;
@@ -172,7 +201,7 @@ pub fn domains_svg(
                         .map_err(err)?;
                     if !layer.label.is_empty() {
                         legend = true;
-                        anno.label(layer.label.as_str()).legend(move |(x, y)| {
+                        anno.label(svg_text(&layer.label)).legend(move |(x, y)| {
                             Rectangle::new([(x, y - 6), (x + 18, y + 6)], outline.stroke_width(2))
                         });
                     }
@@ -186,28 +215,29 @@ pub fn domains_svg(
                 &m.points,
                 Marker::Triangle,
                 color(1 + i),
-                &m.label,
+                Some(&m.label),
                 false,
             )?;
         }
         if legend {
-            draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+            draw_legend(&mut chart, at)?;
         }
         if value_range.is_some() {
+            let right = titled_at(&right.margin(20, 0, 0, 0), colour_label, TICK_PT)?;
+            let bar_h = right.dim_in_pixel().1.saturating_sub(80) as f64;
+            let vt = TickedAxis::new(v0, v0 + span, false, bar_h, false);
+            let vl = vt.ticks.clone();
             let mut bar = ChartBuilder::on(&right)
-                .margin_top(40)
                 .margin_bottom(80)
                 .margin_right(10)
                 .y_label_area_size(80)
-                .caption(colour_label, (FONT, TICK_PT))
-                .build_cartesian_2d(0.0..1.0, v0..(v0 + span))
+                .build_cartesian_2d(0.0..1.0, vt)
                 .map_err(err)?;
             bar.configure_mesh()
                 .disable_x_mesh()
                 .disable_x_axis()
                 .label_style((FONT, TICK_PT))
-                .y_labels(8)
-                .y_label_formatter(&|v| format!("{v:.3e}"))
+                .y_label_formatter(&|v| vl.label(*v))
                 .light_line_style(WHITE.mix(0.0))
                 .draw()
                 .map_err(err)?;
@@ -259,41 +289,14 @@ pub enum LegendCorner {
 }
 
 impl LegendCorner {
-    fn position(self) -> SeriesLabelPosition {
+    fn corner(self) -> Corner {
         match self {
-            LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
-            LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
-            LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
-            LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
+            LegendCorner::UpperLeft => Corner::UpperLeft,
+            LegendCorner::UpperRight => Corner::UpperRight,
+            LegendCorner::LowerLeft => Corner::LowerLeft,
+            LegendCorner::LowerRight => Corner::LowerRight,
         }
     }
-}
-
-fn tick(v: f64, log: bool) -> String {
-    if log {
-        format!("{v:.0e}")
-    } else if v.abs() < 1e-12 {
-        // A tick at zero computed as a sum of steps (e.g. -1.1e-16).
-        "0".to_string()
-    } else if v != 0.0 && (v.abs() < 1e-2 || v.abs() >= 1e5) {
-        format!("{v:.1e}")
-    } else {
-        let s = format!("{v:.4}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
-        s.to_string()
-    }
-}
-
-fn chart_builder<'a, 'b, DB: DrawingBackend>(
-    root: &'a DrawingArea<DB, plotters::coord::Shift>,
-    title: &'b str,
-) -> ChartBuilder<'a, 'b, DB> {
-    let mut b = ChartBuilder::on(root);
-    b.caption(title, (FONT, CAPTION_PT))
-        .margin(20)
-        .x_label_area_size(60)
-        .y_label_area_size(100);
-    b
 }
 
 /// Series on linear or logarithmic axes, each in its own colour and marker.
@@ -318,75 +321,106 @@ pub fn xy_svg(title: &str, axes: &XyAxes, series: &[XySeries]) -> PlotResult<Str
     };
     let (x0, x1) = widen(x0, x1, axes.log_x);
     let (y0, y1) = widen(y0, y1, axes.log_y);
+    let y_area = 100;
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        // plotters types a log axis differently from a linear one, so each combination is its
-        // own chart; the drawing code is shared through the macro below.
-        macro_rules! draw {
-            ($chart:expr) => {{
-                let mut chart = $chart;
+        let area = titled(&root, title)?;
+        let (w, h) = plot_size(&area, y_area);
+        // The legend goes where it covers no series (the study's corner first), or in a band
+        // the y range is stretched by.
+        let frac = |p: &(f64, f64)| {
+            (
+                fraction(p.0, x0, x1, axes.log_x),
+                fraction(p.1, y0, y1, axes.log_y),
+            )
+        };
+        let labels: Vec<String> = series
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| legend_label(i, series.len(), &s.label))
+            .collect();
+        let kept: Vec<Vec<(f64, f64)>> = series
+            .iter()
+            .map(|s| s.points.iter().copied().filter(keep).collect())
+            .collect();
+        let points: Vec<(f64, f64)> = series
+            .iter()
+            .zip(&kept)
+            .filter(|(s, _)| s.markers)
+            .flat_map(|(_, p)| p.iter().map(frac))
+            .collect();
+        let lines: Vec<Vec<(f64, f64)>> = series
+            .iter()
+            .zip(&kept)
+            .filter(|(s, _)| s.line || !s.markers)
+            .map(|(_, p)| p.iter().map(frac).collect())
+            .collect();
+        let (at, (f0, f1)) = legend_place(&labels, &points, &lines, (w, h), axes.legend.corner());
+        let (y0, y1) = (
+            at_fraction(f0, y0, y1, axes.log_y),
+            at_fraction(f1, y0, y1, axes.log_y),
+        );
+        let xt = TickedAxis::new(x0, x1, axes.log_x, w, true);
+        let yt = TickedAxis::new(y0, y1, axes.log_y, h, false);
+        let (xl, yl) = (xt.ticks.clone(), yt.ticks.clone());
+        let mut chart = chart_on(&area, y_area).build_cartesian_2d(xt, yt).map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc(svg_text(&axes.x_desc))
+            .y_desc(svg_text(&axes.y_desc))
+            .axis_desc_style((FONT, AXIS_DESC_PT))
+            .label_style((FONT, TICK_PT))
+            .x_label_formatter(&|v| xl.label(*v))
+            .y_label_formatter(&|v| yl.label(*v))
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(err)?;
+        for (value, label) in &axes.y_lines {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(x0, *value), (x1, *value)],
+                    6,
+                    4,
+                    BLACK.mix(0.5).stroke_width(1),
+                ))
+                .map_err(err)?;
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    svg_text(label),
+                    (x0, *value),
+                    (FONT, TICK_PT).into_font().color(&BLACK.mix(0.7)),
+                )))
+                .map_err(err)?;
+        }
+        for (i, (s, p)) in series.iter().zip(&kept).enumerate() {
+            let label = legend_label(i, series.len(), &s.label);
+            if s.markers {
+                draw_markers(&mut chart, p, Marker::nth(i), color(i), label.as_deref(), s.line)?;
+                continue;
+            }
+            let style = color(i).stroke_width(2);
+            let anno = if dashed(i) {
                 chart
-                    .configure_mesh()
-                    .x_desc(axes.x_desc.as_str())
-                    .y_desc(axes.y_desc.as_str())
-                    .axis_desc_style((FONT, AXIS_DESC_PT))
-                    .label_style((FONT, TICK_PT))
-                    .x_label_formatter(&|v| tick(*v, false))
-                    .y_label_formatter(&|v| tick(*v, axes.log_y))
-                    .light_line_style(WHITE.mix(0.0))
-                    .draw()
-                    .map_err(err)?;
-                for (value, label) in &axes.y_lines {
-                    chart
-                        .draw_series(DashedLineSeries::new(
-                            [(x0, *value), (x1, *value)],
-                            6,
-                            4,
-                            BLACK.mix(0.5).stroke_width(1),
-                        ))
-                        .map_err(err)?;
-                    chart
-                        .draw_series(std::iter::once(Text::new(
-                            label.clone(),
-                            (x0, *value),
-                            (FONT, TICK_PT).into_font().color(&BLACK.mix(0.7)),
-                        )))
-                        .map_err(err)?;
-                }
-                for (i, s) in series.iter().enumerate() {
-                    let p: Vec<(f64, f64)> = s.points.iter().copied().filter(keep).collect();
-                    if s.markers {
-                        draw_markers(&mut chart, &p, Marker::nth(i), color(i), &s.label, s.line)?;
-                    } else {
-                        let col = color(i);
-                        chart
-                            .draw_series(LineSeries::new(p, col.stroke_width(2)))
-                            .map_err(err)?
-                            .label(s.label.as_str())
-                            .legend(move |(x, y)| {
-                                PathElement::new(vec![(x, y), (x + 24, y)], col.stroke_width(2))
-                            });
-                    }
-                }
-                draw_legend(&mut chart, axes.legend.position())?;
-            }};
+                    .draw_series(DashedLineSeries::new(p.iter().copied(), 8, 5, style))
+                    .map_err(err)?
+            } else {
+                chart
+                    .draw_series(LineSeries::new(p.iter().copied(), style))
+                    .map_err(err)?
+            };
+            if let Some(label) = label {
+                // A dashed series' legend line has a gap.
+                let gap = if dashed(i) { 8 } else { 14 };
+                anno.label(label).legend(move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (gap, 0)], style)
+                        + PathElement::new(vec![(14, 0), (24, 0)], style)
+                });
+            }
         }
-        match (axes.log_x, axes.log_y) {
-            (false, false) => draw!(chart_builder(&root, title)
-                .build_cartesian_2d(x0..x1, y0..y1)
-                .map_err(err)?),
-            (true, false) => draw!(chart_builder(&root, title)
-                .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
-                .map_err(err)?),
-            (false, true) => draw!(chart_builder(&root, title)
-                .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
-                .map_err(err)?),
-            (true, true) => draw!(chart_builder(&root, title)
-                .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-                .map_err(err)?),
-        }
+        draw_legend(&mut chart, at)?;
         root.present().map_err(err)?;
     }
     Ok(svg)

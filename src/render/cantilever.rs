@@ -25,7 +25,7 @@ fn case_label(study: &CantileverStudy, r: &CantileverRecord) -> String {
         .cases
         .iter()
         .find(|c| c.id == r.id)
-        .map_or_else(|| r.id.clone(), |c| c.title.clone())
+        .map_or_else(|| super::md_cell(&r.id), |c| super::md_cell(&c.title))
 }
 
 /// The main report.
@@ -34,8 +34,8 @@ pub fn report_markdown(results: &CantileverResults, not_drawn: &[super::NotDrawn
     let (pass, fail, none) = check_counts(&results.checks);
     let mut s = format!(
         "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated.\n\n",
-        study.name,
-        study.summary,
+        super::md_text(&study.name),
+        super::md_text(&study.summary),
         results.provenance.line()
     );
     let _ = write!(
@@ -104,7 +104,7 @@ pub fn report_markdown(results: &CantileverResults, not_drawn: &[super::NotDrawn
         let _ = write!(
             s,
             "## {}\n\nEvery method on the beam's base case at each element size (h = {}); Δ = u/u_ref − 1 (v likewise) against {} at the same h; the last column against the reference's u/L ({}). {}{}\n\n| method | h | status | u/L | v/L | Δu | Δv | u/L over the reference |\n|---|---:|---|---:|---:|---:|---:|---:|\n",
-            r.title,
+            super::md_text(&r.title),
             r.element_sizes.iter().map(|h| h.to_string()).collect::<Vec<_>>().join(", "),
             r.reference.label(),
             reference.as_ref().map_or("none".into(), |(u, what)| format!("{u:.6}: {what}")),

@@ -27,7 +27,12 @@ fn ppc_label(results: &CompactionResults, p: usize) -> String {
 
 /// Table 2 / Table 3: this code's residuals beside the paper's, per step and iteration.
 pub fn residual_table(results: &CompactionResults, p: &PaperResiduals) -> String {
-    let mut s = format!("# {}: {}\n\n{}\n\n", p.table, p.title, results.provenance.line());
+    let mut s = format!(
+        "# {}: {}\n\n{}\n\n",
+        super::md_text(&p.table),
+        super::md_text(&p.title),
+        results.provenance.line()
+    );
     let case = results.igimp_case(&p.sweep, p.element_size, p.points_per_cell as usize);
     let measure = match results.study.newton.residual_norm {
         ResidualNorm::External => "‖f_int − f_ext‖ / ‖f_ext‖ over the free dofs (`external`)",
@@ -231,8 +236,8 @@ pub fn report_markdown(results: &CompactionResults, not_drawn: &[super::NotDrawn
     let count = |st| results.cases.iter().filter(|c| c.solve.status == st).count();
     let mut s = format!(
         "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated. Cases: {} converged, {} failed, {} rejected.\n\n",
-        spec.name,
-        spec.summary,
+        super::md_text(&spec.name),
+        super::md_text(&spec.summary),
         results.provenance.line(),
         count(CaseStatus::Converged),
         count(CaseStatus::Failed),
@@ -242,7 +247,13 @@ pub fn report_markdown(results: &CompactionResults, not_drawn: &[super::NotDrawn
     s.push_str(&super::gci_markdown(&results.measures.gci));
     s.push_str(&checks_markdown(&results.checks));
     for p in &spec.paper_residuals {
-        let _ = writeln!(s, "- {}: [{}]({})", p.table, p.title, p.file);
+        let _ = writeln!(
+            s,
+            "- {}: [{}]({})",
+            super::md_text(&p.table),
+            super::md_link_text(&p.title),
+            p.file
+        );
     }
     s.push('\n');
     s.push_str(&cases_table(results));

@@ -28,8 +28,8 @@ pub fn report_markdown(results: &DynamicResults, not_drawn: &[super::NotDrawn]) 
     let (pass, fail, none) = check_counts(&results.checks);
     let mut s = format!(
         "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated.\n\n",
-        study.name,
-        study.summary,
+        super::md_text(&study.name),
+        super::md_text(&study.summary),
         results.provenance.line()
     );
     if let Some(b) = &study.bar {
@@ -96,19 +96,22 @@ pub fn report_markdown(results: &DynamicResults, not_drawn: &[super::NotDrawn]) 
             let _ = writeln!(
                 s,
                 "## {}\n\n{}\n\n| case | elements through the depth | steps per T₁ | tip | peak deflection | period | period error | energy | Newton iterations (most per step) | steps at round-off floor | steps cut back |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
-                sw.id, sw.title
+                super::md_text(&sw.id),
+                super::md_text(&sw.title)
             );
         } else if study.bar.is_some() {
             let _ = writeln!(
                 s,
                 "## {}\n\n{}\n\n| case | elements | steps per period | displacement | period | period error | energy | Newton iterations (most per step) | steps at round-off floor | steps cut back |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
-                sw.id, sw.title
+                super::md_text(&sw.id),
+                super::md_text(&sw.title)
             );
         } else {
             let _ = writeln!(
                 s,
                 "## {}\n\n{}\n\n| case | cells per side | steps per period | displacement | stress | Newton iterations (most per step) | steps at round-off floor | steps cut back |\n|---|---:|---:|---:|---:|---:|---:|---:|",
-                sw.id, sw.title
+                super::md_text(&sw.id),
+                super::md_text(&sw.title)
             );
         }
         for ser in results.sweep_series(&sw.id) {

@@ -40,8 +40,8 @@ pub fn report_markdown(results: &Results, not_drawn: &[super::NotDrawn]) -> Stri
     let (pass, fail, none) = check_counts(&results.checks);
     let mut s = format!(
         "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated.\n\n",
-        study.name,
-        study.summary,
+        super::md_text(&study.name),
+        super::md_text(&study.summary),
         results.provenance.line()
     );
     let dim = study.dimension as usize;
@@ -70,7 +70,12 @@ pub fn report_markdown(results: &Results, not_drawn: &[super::NotDrawn]) -> Stri
             Field::AxisAligned => study.amplitude.axis_aligned,
             Field::Vortex => study.amplitude.vortex,
         };
-        let _ = writeln!(s, "## {}\n\n{} (amplitude {amplitude}).\n", sw.id, sw.title);
+        let _ = writeln!(
+            s,
+            "## {}\n\n{} (amplitude {amplitude}).\n",
+            super::md_text(&sw.id),
+            super::md_text(&sw.title)
+        );
         for m in ErrorMeasure::ALL {
             let _ = write!(s, "### {}\n\n| series |", m.label());
             for n in &cells {

@@ -48,13 +48,58 @@ fn rate_cell(rows: &[&RateRow]) -> String {
     cells.join(" / ")
 }
 
-fn report(r: &MethodsResults, drawn: &[(String, String)]) -> String {
+/// An identifier of the gathered results in words, for axis labels, titles and headings
+/// (`steps_per_period` is the case field a sweep refines, not a label).
+fn in_words(text: &str) -> String {
+    text.replace("stress_error error", "stress error")
+        .replace("f_error error", "deformation gradient error")
+        .replace("steps_per_period", "time steps per period")
+        .replace("stress_error", "stress error")
+        .replace("f_error", "deformation gradient error")
+}
+
+/// The axis label of a group's x axis: what is counted, in words.
+fn x_words(x_desc: &str) -> String {
+    match x_desc {
+        "cells" => "cells per side".into(),
+        "elements" => "number of elements".into(),
+        other => in_words(other),
+    }
+}
+
+/// The report file of each source study, as its `results.json` names it (`report_file`,
+/// else `report.md`), relative to the methods folder; `None` where that file is not there
+/// (nothing links a missing file).
+fn report_links(dir: &Path, r: &MethodsResults) -> Vec<Option<String>> {
+    r.sources
+        .iter()
+        .map(|x| {
+            let study_dir = dir.join("..").join(&x.study);
+            let file = read_json::<serde_json::Value>(&study_dir.join("results.json"))
+                .ok()
+                .and_then(|v| v["study"]["report_file"].as_str().map(str::to_string))
+                .unwrap_or_else(|| "report.md".into());
+            let safe = !file.contains("..") && !file.starts_with('/');
+            (safe && study_dir.join(&file).is_file()).then(|| format!("../{}/{file}", x.study))
+        })
+        .collect()
+}
+
+fn report(r: &MethodsResults, links: &[Option<String>], drawn: &[(String, String)]) -> String {
     let mut s = format!(
         "# methods: every method side by side\n\nGathered from the studies' `results.json` in this output folder by `study` ({}); regenerate, do not edit. Nothing here is solved: each number is its study's, whose report says how it was obtained and checked.\n\nSources: {}.\n\n",
         r.software.label(),
         r.sources
             .iter()
-            .map(|x| format!("[{0}](../{0}/report.md) ({1} tier, {2})", x.study, x.tier, x.software))
+            .zip(links)
+            .map(|(x, link)| {
+                let name = super::md_link_text(&x.study);
+                let at = format!("({} tier, {})", super::md_text(&x.tier), super::md_text(&x.software));
+                match link {
+                    Some(l) => format!("[{name}]({l}) {at}"),
+                    None => format!("{name} {at}"),
+                }
+            })
             .collect::<Vec<_>>()
             .join(", ")
     );
@@ -78,7 +123,13 @@ fn report(r: &MethodsResults, drawn: &[(String, String)]) -> String {
         }
     }
     for (study, measure, group) in keys {
-        let _ = write!(s, "| {study} | {measure} | {group} |");
+        let _ = write!(
+            s,
+            "| {} | {} | {} |",
+            super::md_cell(study),
+            super::md_cell(&in_words(measure)),
+            super::md_cell(group)
+        );
         for m in &methods {
             let rows: Vec<&RateRow> = r
                 .rates
@@ -99,9 +150,9 @@ fn report(r: &MethodsResults, drawn: &[(String, String)]) -> String {
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                x.study,
-                x.sweep,
-                x.measure,
+                super::md_cell(&x.study),
+                super::md_cell(&x.sweep),
+                super::md_cell(&in_words(&x.measure)),
                 x.method.label(),
                 x.ratios
                     .iter()
@@ -111,8 +162,8 @@ fn report(r: &MethodsResults, drawn: &[(String, String)]) -> String {
                 x.extrapolated_ratio
                     .map_or("—".into(), |q| format!("{:+.3} %", 100.0 * (q - 1.0))),
                 x.observed_order.map_or("—".into(), |p| format!("{p:.2}")),
-                x.gci_note,
-                x.reference
+                super::md_cell(&x.gci_note),
+                super::md_cell(&x.reference)
             );
         }
         s.push('\n');
@@ -120,7 +171,12 @@ fn report(r: &MethodsResults, drawn: &[(String, String)]) -> String {
     if !drawn.is_empty() {
         s.push_str("## Figures\n\n");
         for (title, id) in drawn {
-            let _ = writeln!(s, "### {title}\n\n![{id}]({id}.svg)\n");
+            let _ = writeln!(
+                s,
+                "### {}\n\n![{}]({id}.svg)\n",
+                super::md_text(title),
+                super::md_link_text(id)
+            );
         }
     }
     s
@@ -130,6 +186,7 @@ fn report(r: &MethodsResults, drawn: &[(String, String)]) -> String {
 /// written.
 pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
     let r: MethodsResults = read_json(&dir.join(RESULTS))?;
+    let links = report_links(dir, &r);
     let mut files = super::Files::new(dir);
     let mut drawn = vec![];
     for g in &r.groups {
@@ -144,8 +201,8 @@ pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
             })
             .collect();
         let axes = XyAxes {
-            x_desc: g.x_desc.clone(),
-            y_desc: g.y_desc.clone(),
+            x_desc: x_words(&g.x_desc),
+            y_desc: in_words(&g.y_desc),
             log_x: true,
             log_y: g.log_y,
             y_lines: if g.log_y {
@@ -155,12 +212,13 @@ pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
             },
             legend: LegendCorner::LowerLeft,
         };
-        let svg = xy_svg(&g.title, &axes, &series).ok();
+        let title = in_words(&g.title);
+        let svg = xy_svg(&title, &axes, &series).ok();
         if svg.is_some() {
-            drawn.push((g.title.clone(), g.id.clone()));
+            drawn.push((title, g.id.clone()));
         }
         files.figure(&g.id, svg, "no data")?;
     }
-    files.report(REPORT, &report(&r, &drawn))?;
+    files.report(REPORT, &report(&r, &links, &drawn))?;
     Ok(files.done())
 }

@@ -8,6 +8,7 @@ mod column3d_study;
 mod compaction_reference_study;
 mod compaction_study;
 mod defects;
+mod figures;
 mod first_contact;
 mod manufactured3d_study;
 mod manufactured_dynamic_study;

@@ -146,12 +146,23 @@ pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
     s.push('\n');
     for f in &results.study.figures {
         if dir.join(format!("{}.svg", f.id)).is_file() {
-            let _ = writeln!(s, "### {}\n\n![{}]({name}/{}.svg)\n", f.title, f.title, f.id);
+            let _ = writeln!(
+                s,
+                "### {}\n\n![{}]({name}/{}.svg)\n",
+                super::md_text(&f.title),
+                super::md_link_text(&f.title),
+                f.id
+            );
         } else {
-            let _ = writeln!(s, "### {}\n\nNot drawn (no data): see the report.\n", f.title);
+            let _ = writeln!(
+                s,
+                "### {}\n\nNot drawn (no data): see the report.\n",
+                super::md_text(&f.title)
+            );
         }
     }
     Ok(IndexEntry {
+        name: name.to_string(),
         markdown: s,
         checks: counts,
     })

@@ -7,7 +7,12 @@ use super::*;
 pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::render::NotDrawn]) -> String {
     let spec = &results.study;
     let mut s = String::new();
-    let _ = writeln!(s, "# {}: {}\n", spec.name, spec.summary);
+    let _ = writeln!(
+        s,
+        "# {}: {}\n",
+        crate::render::md_text(&spec.name),
+        crate::render::md_text(&spec.summary)
+    );
     let _ = writeln!(s, "{}\n", results.provenance.line());
     let (pass, fail, none) = results.check_counts();
     let _ = writeln!(
@@ -163,7 +168,12 @@ pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::render::NotD
             continue;
         }
         let ids = of_sweep(results, &sweep.id);
-        let _ = writeln!(s, "### Sweep `{}`: {}\n", sweep.id, sweep.title);
+        let _ = writeln!(
+            s,
+            "### Sweep `{}`: {}\n",
+            sweep.id,
+            crate::render::md_text(&sweep.title)
+        );
         for &load in &plan.weights {
             for (m, ppc) in sweep_series(results, &sweep.id, load) {
                 let cs = series(&results.cases, ids, m, load, ppc);
