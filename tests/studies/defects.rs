@@ -393,11 +393,12 @@ fn a_figure_without_data_is_a_warning_not_a_failed_study() {
     let index = std::fs::read_to_string(out.join("index.md")).unwrap();
     assert!(!index.contains("conv.svg"), "{index}");
     assert!(!out.join("t/conv.svg").exists());
-    // The same with a quick tier that skips the sweep.
+    // A quick tier that skips the only sweep is an empty run: an error naming it, not a
+    // silent exit 0 (first contact, D8).
     let skipped = with(TINY, "[[figures]]", "[sweeps.quick]\nskip = true\n[[figures]]");
     let (_, o, err) = tiny_run(tmp.path(), &skipped, &["--quick"]);
-    assert!(o.status.success(), "{err}");
-    assert!(err.contains("not drawn"), "{err}");
+    assert!(!o.status.success(), "{err}");
+    assert!(err.contains("quick tier: 0 cases"), "{err}");
 }
 
 /// With stderr not a terminal (a Slurm log), every finished case is a line with the elapsed
