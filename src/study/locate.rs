@@ -168,14 +168,15 @@ fn resolve_exact(doc: &ImDocument<&str>, scope: &str, field: &str) -> Option<Str
 pub fn locate(text: &str, err: StudyError) -> StudyError {
     let doc = ImDocument::parse(text).ok();
     let (file, key, value, allowed) = match err {
-        StudyError::CaseInput {
-            file,
-            scope,
-            case,
-            field,
-            value,
-            allowed,
-        } => {
+        StudyError::CaseInput(c) => {
+            let super::CaseInput {
+                file,
+                scope,
+                case,
+                field,
+                value,
+                allowed,
+            } = *c;
             let key = doc
                 .as_ref()
                 .and_then(|d| resolve(d, &scope, &field))
@@ -248,14 +249,14 @@ mod tests {
     fn a_case_input_error_names_the_key_and_its_line() {
         let e = locate(
             TEXT,
-            StudyError::CaseInput {
+            StudyError::CaseInput(Box::new(crate::study::CaseInput {
                 file: "s.toml".into(),
                 scope: "sweeps[0]".into(),
                 case: "igimp-h1".into(),
                 field: "half_width".into(),
                 value: "-4".into(),
                 allowed: "must be > 0".into(),
-            },
+            })),
         );
         assert_eq!(
             e.to_string(),

@@ -58,16 +58,8 @@ pub enum StudyError {
     /// A problem input made invalid by a study file's values, named as the problem calls it
     /// (`half_width`); [`locate::locate`] turns it into [`StudyError::Invalid`] naming the
     /// file's key (`block.half_width`) and its line.
-    #[error("{file}: invalid `{field}` = {value}: {allowed} (in case {case}, `{scope}`)")]
-    CaseInput {
-        file: String,
-        /// The section whose case it is, e.g. `sweeps[0]` or `sweeps[0].quick`.
-        scope: String,
-        case: String,
-        field: String,
-        value: String,
-        allowed: String,
-    },
+    #[error("{0}")]
+    CaseInput(Box<CaseInput>),
     /// A study folder without `results.json` (nothing to render).
     #[error("{path}: No such file or directory (os error 2): solve the study first")]
     NoResults { study: String, path: String },
@@ -91,6 +83,19 @@ pub enum StudyError {
         /// Why they may be missing (e.g. the store holds another tier's cases), or empty.
         hint: String,
     },
+}
+
+/// See [`StudyError::CaseInput`].
+#[derive(Debug, Error)]
+#[error("{file}: invalid `{field}` = {value}: {allowed} (in case {case}, `{scope}`)")]
+pub struct CaseInput {
+    pub file: String,
+    /// The section whose case it is, e.g. `sweeps[0]` or `sweeps[0].quick`.
+    pub scope: String,
+    pub case: String,
+    pub field: String,
+    pub value: String,
+    pub allowed: String,
 }
 
 /// How a run shares its cases between processes (`study --shard K/N`, `study --merge`).

@@ -112,11 +112,12 @@ pub struct BuildId {
 impl BuildId {
     /// This binary's build.
     pub fn this_build() -> Self {
-        let software = super::results::Software::this_build();
+        // The same build.rs values as `results::Software::this_build`, read here so that the
+        // store stays below the results module (tests/verification/layering.rs).
         BuildId {
             source: env!("IGIMP_SOURCE_DIGEST").to_string(),
-            commit: software.commit.unwrap_or_else(|| "unknown".into()),
-            dirty: software.dirty,
+            commit: env!("IGIMP_GIT_COMMIT").to_string(),
+            dirty: env!("IGIMP_GIT_DIRTY").parse().ok(),
         }
     }
 }

@@ -180,14 +180,14 @@ impl Checker<'_> {
     /// Case `case` of the section `scope` (`sweeps[0]`, `cases[2]`) is an invalid problem
     /// input `e`, whose field the problem names ([`super::locate`] finds the file's key).
     pub fn case_input(&self, scope: &str, case: &str, e: crate::error::InputError) -> StudyError {
-        StudyError::CaseInput {
+        StudyError::CaseInput(Box::new(super::CaseInput {
             file: self.file.to_string(),
             scope: scope.to_string(),
             case: case.to_string(),
             field: e.field,
             value: e.value,
             allowed: e.allowed,
-        }
+        }))
     }
     pub fn count(&self, key: &str, v: i64, lo: i64, hi: i64) -> Result<(), StudyError> {
         if (lo..=hi).contains(&v) {

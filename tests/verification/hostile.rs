@@ -42,6 +42,7 @@ const FIELDS: &[&str] = &[
     "summary",
     "problem",
     "report_file",
+    "expected_failures",
     "column",
     "length",
     "young_modulus",
@@ -135,7 +136,7 @@ fn check_error(e: &StudyError, expected_key: Option<&str>) -> Result<(), TestCas
         StudyError::Io { .. }
         | StudyError::ShardDone { .. }
         | StudyError::MissingCases { .. }
-        | StudyError::CaseInput { .. }
+        | StudyError::CaseInput(_)
         | StudyError::NoResults { .. } => {
             prop_assert!(false, "unexpected error from parsing {msg}")
         }

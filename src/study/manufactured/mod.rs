@@ -97,7 +97,7 @@ fn is_plane(d: &i64) -> bool {
     *d == 2
 }
 
-pub(super) fn default_updates() -> Vec<DomainUpdate> {
+fn default_updates() -> Vec<DomainUpdate> {
     vec![DomainUpdate::Stretch]
 }
 

@@ -62,12 +62,12 @@ impl ManufacturedStudy {
             chk.text(&format!("sweeps[{i}].title"), &s.title)?;
             chk.non_empty(&format!("sweeps[{i}].domain_updates"), &s.domain_updates)?;
             if !s.methods.iter().any(|m| m.uses_domain_update())
-                && s.domain_updates != super::default_updates()
+                && s.domain_updates != [DomainUpdate::Stretch]
             {
                 return Err(chk.err(
                     format!("sweeps[{i}].domain_updates"),
-                    format!("{:?}", s.domain_updates),
-                    "must be left out: none of the sweep's methods updates point domains (only the domain-averaged families, e.g. igimp, do)",
+                    serde_json::to_string(&s.domain_updates).unwrap_or_default(),
+                    "must be left out (its default is [\"stretch\"]): none of the sweep's methods updates point domains (only the domain-averaged families, e.g. igimp, do)",
                 ));
             }
             if let Some(n) = s.fit_points {
