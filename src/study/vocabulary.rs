@@ -334,7 +334,7 @@ pub fn parse_toml<T: DeserializeOwned>(text: &str, file: &str) -> Result<T, Stud
         let message = e.to_string().trim_end().to_string();
         // A key missing from the top level is reported at the document's span, line 1 column 1
         // (often a comment): say where it belongs instead.
-        let top_level = e.span().is_some_and(|s| s.start == 0 && s.end >= text.trim_end().len());
+        let top_level = e.span().is_some_and(|s| s.start == 0 && !text.starts_with('['));
         let missing = message
             .lines()
             .last()

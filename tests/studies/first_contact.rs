@@ -380,3 +380,23 @@ fn a_merge_of_another_tier_says_so() {
     assert!(!o.status.success(), "{err}");
     assert!(err.contains("another tier (--quick)"), "{err}");
 }
+
+/// D5: a key missing from the top level was reported at line 1, column 1 (often a comment);
+/// now the error says where the key belongs.
+#[test]
+fn a_missing_top_level_key_says_where_it_belongs() {
+    let t: String = repo_study("column")
+        .lines()
+        .filter(|l| !l.starts_with("summary ="))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let tmp = tempfile::tempdir().unwrap();
+    write(tmp.path(), "s.toml", &t);
+    let (o, err) = study(&["s.toml", "--render-only", "--out", "out"], tmp.path());
+    assert!(!o.status.success(), "{err}");
+    assert!(
+        err.contains("missing required key `summary` at the top level of the file"),
+        "{err}"
+    );
+    assert!(!err.contains("line 1, column 1"), "{err}");
+}
