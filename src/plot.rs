@@ -205,6 +205,30 @@ pub(crate) fn chart_on<'a, 'b, DB: DrawingBackend>(
     b
 }
 
+/// The chart of an x–y figure on `area`: both axes with their own ticks ([`TickedAxis`]) and
+/// descriptions, no grid lines.
+pub(crate) fn axes_chart<'a, DB: DrawingBackend + 'a>(
+    area: &'a DrawingArea<DB, Shift>,
+    y_area: u32,
+    (xt, yt): (TickedAxis, TickedAxis),
+    (x_desc, y_desc): (&str, &str),
+) -> Result<ChartContext<'a, DB, Cartesian2d<TickedAxis, TickedAxis>>, String> {
+    let (xl, yl) = (xt.ticks.clone(), yt.ticks.clone());
+    let mut chart = chart_on(area, y_area).build_cartesian_2d(xt, yt).map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(svg_text(x_desc))
+        .y_desc(svg_text(y_desc))
+        .axis_desc_style((FONT, AXIS_DESC_PT))
+        .label_style((FONT, TICK_PT))
+        .x_label_formatter(&|v| xl.label(*v))
+        .y_label_formatter(&|v| yl.label(*v))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
+}
+
 /// Where the legend of `labels` goes on a plot of `size` pixels, given the data in plot
 /// fractions (see [`place_legend`]): its position and the y range's new fractions.
 pub(crate) fn legend_place(
@@ -370,19 +394,7 @@ pub fn profile_svg(
         let (y0, y1) = (at_fraction(f0, y0, y1, false), at_fraction(f1, y0, y1, false));
         let xt = TickedAxis::new(x0, x1, false, size.0, true);
         let yt = TickedAxis::new(y0, y1, false, size.1, false);
-        let (xl, yl) = (xt.ticks.clone(), yt.ticks.clone());
-        let mut chart = chart_on(&area, y_area).build_cartesian_2d(xt, yt).map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(svg_text(x_desc))
-            .y_desc(svg_text(y_desc))
-            .axis_desc_style((FONT, AXIS_DESC_PT))
-            .label_style((FONT, TICK_PT))
-            .x_label_formatter(&|v| xl.label(*v))
-            .y_label_formatter(&|v| yl.label(*v))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(err)?;
+        let mut chart = axes_chart(&area, y_area, (xt, yt), (x_desc, y_desc))?;
         for (i, curve) in analytical.iter().enumerate() {
             let style = if i == 0 {
                 BLACK.stroke_width(2)

@@ -7,9 +7,9 @@
 //! function of the data so that `study --render-only` is byte-identical.
 
 use crate::plot::{
-    at_fraction, chart_on, color, dashed, draw_legend, draw_markers, err, fraction, legend_label,
+    at_fraction, axes_chart, color, dashed, draw_legend, draw_markers, err, fraction, legend_label,
     legend_place, padded, plot_size, svg_text, titled, titled_at, Corner, Marker, PlotResult, TickedAxis,
-    AXIS_DESC_PT, FONT, SIZE, TICK_PT,
+    FONT, SIZE, TICK_PT,
 };
 use plotters::prelude::*;
 
@@ -143,19 +143,7 @@ pub fn domains_svg(
         }
         let xt = TickedAxis::new(x0, x1, false, w, true);
         let yt = TickedAxis::new(y0, y1, false, h, false);
-        let (xl, yl) = (xt.ticks.clone(), yt.ticks.clone());
-        let mut chart = chart_on(&left, y_area).build_cartesian_2d(xt, yt).map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(svg_text(axes.0))
-            .y_desc(svg_text(axes.1))
-            .axis_desc_style((FONT, AXIS_DESC_PT))
-            .label_style((FONT, TICK_PT))
-            .x_label_formatter(&|v| xl.label(*v))
-            .y_label_formatter(&|v| yl.label(*v))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(err)?;
+        let mut chart = axes_chart(&left, y_area, (xt, yt), (axes.0, axes.1))?;
         let (v0, v1) = value_range.unwrap_or((0.0, 1.0));
         let span = if v1 > v0 { v1 - v0 } else { 1.0 };
         let mut legend = false;
@@ -364,19 +352,7 @@ pub fn xy_svg(title: &str, axes: &XyAxes, series: &[XySeries]) -> PlotResult<Str
         );
         let xt = TickedAxis::new(x0, x1, axes.log_x, w, true);
         let yt = TickedAxis::new(y0, y1, axes.log_y, h, false);
-        let (xl, yl) = (xt.ticks.clone(), yt.ticks.clone());
-        let mut chart = chart_on(&area, y_area).build_cartesian_2d(xt, yt).map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(svg_text(&axes.x_desc))
-            .y_desc(svg_text(&axes.y_desc))
-            .axis_desc_style((FONT, AXIS_DESC_PT))
-            .label_style((FONT, TICK_PT))
-            .x_label_formatter(&|v| xl.label(*v))
-            .y_label_formatter(&|v| yl.label(*v))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(err)?;
+        let mut chart = axes_chart(&area, y_area, (xt, yt), (&axes.x_desc, &axes.y_desc))?;
         for (value, label) in &axes.y_lines {
             chart
                 .draw_series(DashedLineSeries::new(

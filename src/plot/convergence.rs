@@ -1,10 +1,10 @@
 //! Log-log convergence figures: error against resolution per series, with a slope triangle
 //! under each series' finest segment where the fitted slope is positive.
 
-use super::layout::{self, at_fraction, fraction, svg_text};
+use super::layout::{self, at_fraction, fraction};
 use super::{
-    chart_on, color, draw_legend, draw_markers, err, legend_label, legend_place, plot_size, titled,
-    ConvergenceSeries, Corner, Marker, PlotResult, TickedAxis, AXIS_DESC_PT, FONT, SIZE, TICK_PT,
+    axes_chart, color, draw_legend, draw_markers, err, legend_label, legend_place, plot_size, titled,
+    ConvergenceSeries, Corner, Marker, PlotResult, TickedAxis, FONT, SIZE, TICK_PT,
 };
 use plotters::prelude::*;
 
@@ -207,19 +207,7 @@ pub fn convergence_svg_along(
         let (at, _) = legend_place(&labels, &boxes, &data_lines(y0, y1), (w, h), Corner::LowerLeft);
         let xt = TickedAxis::new(x0, x1, true, w, true);
         let yt = TickedAxis::new(y0, y1, true, h, false);
-        let (xl, yl) = (xt.ticks.clone(), yt.ticks.clone());
-        let mut chart = chart_on(&area, y_area).build_cartesian_2d(xt, yt).map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc(svg_text(x_desc))
-            .y_desc(svg_text(y_desc))
-            .axis_desc_style((FONT, AXIS_DESC_PT))
-            .label_style((FONT, TICK_PT))
-            .x_label_formatter(&|v| xl.label(*v))
-            .y_label_formatter(&|v| yl.label(*v))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(err)?;
+        let mut chart = axes_chart(&area, y_area, (xt, yt), (x_desc, y_desc))?;
         for (i, s) in series.iter().enumerate() {
             let label = match s.slope {
                 Some(k) => format!("{} (slope {k:.2})", s.label),
