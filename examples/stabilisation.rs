@@ -145,8 +145,11 @@ fn main() {
                 t.elapsed().as_secs_f64()
             );
         }
-        _ => eprintln!(
-            "usage: stabilisation compaction h ppc treatment [yield] | cantilever treatment [update]"
-        ),
+        _ => {
+            eprintln!(
+                "usage: stabilisation compaction h ppc treatment [yield] | cantilever treatment [update]"
+            );
+            std::process::exit(2);
+        }
     }
 }

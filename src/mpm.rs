@@ -47,6 +47,27 @@ pub struct MpmSettings {
     pub dynamics: Option<Newmark>,
 }
 
+/// The paper's method: iGIMP (eqs 7–10) with the stretch-tensor domain update (eq 39), the
+/// default Newton settings ([`NewtonSettings::default`]), 20 load steps (§5's examples), no
+/// weak-node treatment and no ghost penalty (both chosen per problem by measurement), the
+/// Jacobian volume update, the default direct solver, quasi-static.
+impl Default for MpmSettings {
+    fn default() -> Self {
+        MpmSettings {
+            basis: Basis::Gimp,
+            domain_update: DomainUpdate::Stretch,
+            newton: NewtonSettings::default(),
+            load_steps: 20,
+            weak_node_tolerance: 0.0,
+            weak_node_treatment: WeakNodeTreatment::default(),
+            volume_update: VolumeUpdate::default(),
+            linear_solver: crate::linear::LinearSolver::default(),
+            ghost: GhostSettings::default(),
+            dynamics: None,
+        }
+    }
+}
+
 /// How the committed volume V_p^n of a material point is obtained (eq 28).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]

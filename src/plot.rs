@@ -2,9 +2,9 @@
 //!
 //! plotters is built without its `ttf` feature, so no system font is loaded: text is written
 //! as SVG `<text>` in the generic `sans-serif` family and the viewer picks the face. Every font
-//! size is explicit, and the layout ([`layout`]: ticks, titles, legend place) estimates text
+//! size is explicit, and the layout (`layout`: ticks, titles, legend place) estimates text
 //! extents from character counts, the way tests/studies/figures.rs checks them. Text from a
-//! study file is made XML-safe ([`svg_text`]) before plotters escapes it. The output is a pure
+//! study file is made XML-safe (`svg_text`) before plotters escapes it. The output is a pure
 //! function of the input data, which is what makes `study --render-only` byte-identical.
 
 use plotters::coord::Shift;

@@ -19,7 +19,7 @@ pub const CHUNK: usize = 4096;
 /// rows for CG replaces a row-compressed copy beside the column-compressed matrix (its
 /// values, indices and gather map: 16 of 32 bytes per non-zero; 0.58 GB of the
 /// 1,002,528-element Q4 reference's 36e6 non-zeros) and the gather before every solve.
-/// The inner indices are 4 bytes ([`column_index`]).
+/// The inner indices are 4 bytes (`column_index`).
 #[derive(Debug, Default, Clone)]
 pub struct SparseMatrix {
     /// K (`by_rows`) or Kᵀ: each stored row is a column of K when compressed by columns.
@@ -255,7 +255,7 @@ impl ColumnBlock<'_> {
     /// forward from position `*hint`, which is left just past them. A point's stretches
     /// ascend, and between two of them a column holds only the rows of the few nodes the
     /// point skips, so a short scan finds the next one; a hint outside the column, past the
-    /// row, or more than [`FORWARD_SCAN`] entries short of it falls back to a binary search.
+    /// row, or more than `FORWARD_SCAN` entries short of it falls back to a binary search.
     /// The position found is the same either way.
     #[inline]
     pub fn stretch_with_hint(&mut self, row: usize, col: usize, len: usize, hint: &mut usize) -> &mut [f64] {

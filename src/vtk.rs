@@ -9,7 +9,7 @@
 //! plastic multiplier, displacement), [`gauss_points`] (the same fields for FEM Gauss points,
 //! without domains), [`background_grid`] (lines / quads / hexahedra with nodal vectors) and
 //! [`line_mesh`] and [`element_mesh`] (FEM meshes with nodal displacement). Files are written with
-//! [`crate::study::store::write_atomic`].
+//! [`crate::atomic_file::write_atomic`].
 //!
 //! # References
 //! VTK File Formats, "XML File Formats" (Kitware, VTK User's Guide §19); ParaView's `.pvd`

@@ -256,3 +256,33 @@ fn a_cycle_is_found_when_one_is_added() {
         "{names:?}"
     );
 }
+
+/// The top modules of the verification harness, compiled only with the `harness` feature
+/// (Cargo.toml): everything else is the solver library.
+const HARNESS: [&str; 5] = ["kinds", "plot", "plot2d", "render", "study"];
+
+/// Every edge from a library module to a harness module, as `from → to`.
+fn library_imports_of_harness(g: &BTreeMap<Module, BTreeSet<Module>>) -> Vec<String> {
+    let harness = |m: &Module| m.first().is_some_and(|t| HARNESS.contains(&t.as_str()));
+    g.iter()
+        .filter(|(a, _)| !a.is_empty() && !harness(a))
+        .flat_map(|(a, deps)| {
+            deps.iter()
+                .filter(|d| harness(d))
+                .map(move |d| format!("{} → {}", name(a), name(d)))
+        })
+        .collect()
+}
+
+/// The library builds without the harness (`default-features = false`): no library module
+/// names a harness module. Shown to fail on an added edge mpm → study.
+#[test]
+fn the_library_imports_nothing_of_the_harness() {
+    let mut g = edges(&modules());
+    let found = library_imports_of_harness(&g);
+    assert!(found.is_empty(), "library modules import the harness: {found:?}");
+    g.get_mut(&vec!["mpm".to_string()])
+        .unwrap()
+        .insert(vec!["study".to_string(), "results".to_string()]);
+    assert_eq!(library_imports_of_harness(&g), ["mpm → study::results"]);
+}

@@ -14,6 +14,7 @@ mod column;
 mod compaction;
 mod dynamics;
 mod elastica;
+mod examples;
 mod extreme_values;
 mod families;
 mod fem;
