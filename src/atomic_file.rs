@@ -15,8 +15,8 @@ use std::time::{Duration, SystemTime};
 /// Age after which a temporary file of a writer this process cannot see (another host of a
 /// shared file system, or no `/proc`) counts as abandoned. A temporary lives from its
 /// creation to its rename: one write and one `fsync` of a case record or a VTK file, under a
-/// second for the largest record the studies write (the 1,002,528-element reference's,
-/// 2026-12-01). An hour leaves three orders of magnitude for a slow network file system.
+/// second for the largest record the studies write; an hour leaves three orders of magnitude
+/// for a slow network file system (reference/README.md item 59).
 pub const STALE_TEMP_AGE: Duration = Duration::from_secs(3600);
 
 /// This machine's host name as it appears in temporary file names: `[A-Za-z0-9_]` only (a

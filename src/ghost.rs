@@ -55,8 +55,9 @@ use serde::{Deserialize, Serialize};
 /// do not tile the grid (the U update keeps them axis-aligned under rotation), so a fraction
 /// near 1 marks nearly every cell of a bent beam as cut, and every penalised face between
 /// well-filled cells adds bias without curing anything: the near-null modes live in cells
-/// filled a few per cent. Measured 2026-12-01 (compaction: spread of Figure 17's displacement
-/// over γ ∈ [0.1, 10] at h ≤ 1/2; cantilever, h = 0.5: spread of u/L over γ ∈ [1e-3, 1e-1]):
+/// filled a few per cent. The default is the fraction that keeps both measured spreads over γ
+/// small (reference/README.md item 59; compaction: Figure 17's displacement over
+/// γ ∈ [0.1, 10] at h ≤ 1/2; cantilever, h = 0.5: u/L over γ ∈ [1e-3, 1e-1]):
 ///
 /// | cut_fill | 0.5 | 0.25 | 0.1 | 0.05 |
 /// |---|---:|---:|---:|---:|
@@ -106,18 +107,11 @@ pub struct GhostSettings {
     /// leaves the nodes on its far side (∫ N_v over a layer of depth cut_fill·h at the end of
     /// the hat, times the full tangential hat), the natural companion of `cut_fill`.
     ///
-    /// Measured 2026-12-02. The 3D cantilever (studies/cantilever-3d.toml) at h = 0.25 failed
-    /// at step 12 for every γ: the cells (34, 22, 4..7) beside the free end held 5.36 % (above
-    /// cut_fill = 0.05, so no ghost face) and left the end nodes (35, 23, ·) shares ψ = 7.6e-4
-    /// (at the edges z = 0, 1) and 1.5e-3; the tangent's smallest eigenvalue was 1.06e-2
-    /// against a largest of 9.25e6 (u_x of those nodes, antisymmetric in z), and Newton
-    /// jumped from 2.96e-8 to 14 along it at every cut-back (the mode is in the step's start
-    /// configuration, not in its increment). With cut_share = ½·0.05² = 1.25e-3 the z-edge
-    /// cells count as cut (803 faces instead of 764), the smallest eigenvalue is 10.2 and the
-    /// step converges in 5 iterations. In 2D (cantilever --quick, h = 0.5) the same value
-    /// moves u/L by up to 0.34 % and the spread over γ ∈ [1e-3, 1e-1] from 0.148 % to 0.316 %
-    /// (beyond the 0.2 % band), the compaction's displacements by up to 5e-4 (relative), the
-    /// column's not at all: it is therefore opt-in, set by the 3D cantilever study.
+    /// Opt-in (default 0): it cures the 3D cantilever's near-null mode at h = 0.25, where cells
+    /// filled just above `cut_fill` leave their far nodes tiny shares, but in 2D it moves the
+    /// cantilever's u/L by up to 0.34 % and widens its γ spread beyond the study's band, so
+    /// only the study that needs it sets it (reference/README.md item 59 has the
+    /// measurements).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub cut_share: f64,
 }
@@ -321,10 +315,9 @@ impl<const D: usize> GhostOperator<D> {
     /// where material is, not which nodes its points reach, and the two differ where a
     /// family's fill box covers cells its weights skip: CPDI's corner bounding box (a rotated
     /// domain's box covers cells no corner lies in, and CPDI2 reaches only the nodes of the
-    /// corners' cells). Measured 2026-12-03, 2D cantilever, γ = 1e-2, cut faces: CPDI2 with
-    /// such faces kept locks (u/L −0.352 at h = 1/4 against −0.551 untreated, −0.178 at
-    /// h = 1/8; Q8 −0.5552). GIMP, MPM and the B-splines (with their fill boxes) reach every
-    /// node of every cell their fill boxes overlap, so nothing is dropped for them.
+    /// corners' cells). Kept, such faces lock CPDI2 (the 2D cantilever's u/L far from Q8's,
+    /// reference/README.md item 59). GIMP, MPM and the B-splines (with their fill boxes) reach
+    /// every node of every cell their fill boxes overlap, so nothing is dropped for them.
     pub fn retain_reached(&mut self, supports: &crate::dofs::SupportTable<D>) {
         self.dropped = 0;
         if self.faces.is_empty() {

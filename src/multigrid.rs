@@ -184,10 +184,9 @@ pub fn prolongation(fine: &DofGeometry, origin: [f64; 3], coarse: [f64; 3]) -> (
 #[derive(Debug, Clone)]
 struct Level {
     /// The level's operator (on the finest, a copy of the values of the matrix the hierarchy
-    /// was built from, sharing the solver's pattern ([`Csr`]'s clone): smoothing a kept
-    /// hierarchy's finest level with the current tangent instead, beside coarse operators of
-    /// the old one, tripled the CG iterations of the Q4 compaction, 410 → 1,147 over 20
-    /// steps at h = 1/64, measured 2026-12-02).
+    /// was built from, sharing the solver's pattern ([`Csr`]'s clone)): the finest level must
+    /// match the coarse operators built from it, or the preconditioner degrades (tripled CG
+    /// iterations when it did not, reference/README.md item 59).
     a: Csr,
     p: Csr,
     r: Csr,

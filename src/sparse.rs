@@ -15,10 +15,9 @@ pub const CHUNK: usize = 4096;
 
 /// A square sparse matrix the tangents are assembled into, compressed by columns (what the
 /// direct factorisations read) or by rows (what CG multiplies with, [`Self::set_by_rows`]).
-/// Either way it is stored as a [`Csr`]: of K itself by rows, of Kᵀ by columns. Storing by
-/// rows for CG replaces a row-compressed copy beside the column-compressed matrix (its
-/// values, indices and gather map: 16 of 32 bytes per non-zero; 0.58 GB of the
-/// 1,002,528-element Q4 reference's 36e6 non-zeros) and the gather before every solve.
+/// Either way it is stored as a [`Csr`]: of K itself by rows, of Kᵀ by columns, so that CG
+/// multiplies with the matrix it was assembled into, with no second copy and no gather before
+/// a solve (reference/README.md item 54).
 /// The inner indices are 4 bytes (`column_index`).
 #[derive(Debug, Default, Clone)]
 pub struct SparseMatrix {

@@ -260,8 +260,8 @@ mod tests {
     use super::*;
     use nalgebra::Matrix3;
 
-    /// The support as the search of every listed node builds it (the evaluation before the
-    /// node map and the Gauss table, 2026-12-03).
+    /// The support as the search of every listed node builds it (the evaluation the node map
+    /// and the Gauss table replaced).
     fn searched<const D: usize>(grid: &Grid<D>, corners: &[SVector<f64, D>]) -> PointSupport<D> {
         let mut out = PointSupport::default();
         let mut wf = [0.0; MAX_CORNERS];
