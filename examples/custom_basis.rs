@@ -52,21 +52,12 @@ pub fn column_errors(elements: &[usize]) -> (Vec<(usize, f64)>, f64) {
         let exact = spec.analytical();
         let p = &solver.points;
         let sigma_exact: Vec<f64> = p.position0.iter().map(|x| exact.stress(x[0])).collect();
-        let sigma: Vec<f64> = p
-            .state
-            .iter()
-            .map(|s| s.tau[(0, 0)] / s.f.determinant())
-            .collect();
+        let sigma: Vec<f64> = p.state.iter().map(|s| s.cauchy()[(0, 0)]).collect();
         let e = igimp::norms::stress_error(&sigma_exact, &sigma, &p.volume0, spec.weight, spec.length);
         out.push((n, e));
     }
-    let (xs, ys): (Vec<f64>, Vec<f64>) = out.iter().map(|&(n, e)| ((1.0 / n as f64).ln(), e.ln())).unzip();
-    let (mx, my) = (
-        xs.iter().sum::<f64>() / xs.len() as f64,
-        ys.iter().sum::<f64>() / ys.len() as f64,
-    );
-    let slope = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum::<f64>()
-        / xs.iter().map(|x| (x - mx).powi(2)).sum::<f64>();
+    let (h, e): (Vec<f64>, Vec<f64>) = out.iter().map(|&(n, e)| (1.0 / n as f64, e)).unzip();
+    let slope = igimp::norms::fitted_rate(&h, &e).expect("two or more positive errors");
     (out, slope)
 }
 

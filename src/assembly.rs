@@ -11,6 +11,7 @@
 use crate::constitutive::ConstitutiveModel;
 pub use crate::dofs::{DofMap, SupportTable, MAX_POINT_NODES};
 use crate::dynamics::{Inertia, MassMatrix};
+use crate::error::FailedAttempt;
 use crate::error::StepFailure;
 use crate::ghost::GhostOperator;
 use crate::kinematics::{evaluate_point, PointState, PointTrial};
@@ -990,7 +991,7 @@ impl<const D: usize> StepWorkspace<D> {
         &mut self,
         input: &StepInput<'_, D>,
         settings: &NewtonSettings,
-    ) -> Result<NewtonReport, (StepFailure, Vec<f64>)> {
+    ) -> Result<NewtonReport, FailedAttempt> {
         self.linearised.clear();
         let track = settings.residual_norm == ResidualNorm::Linearised;
         self.with_system_tracking(input, track, |system| {

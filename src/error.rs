@@ -132,6 +132,25 @@ pub enum StepFailure {
     Kinematics { point: usize, reason: String },
 }
 
+/// One attempt at a load step that failed: why, and the normalised residuals of its Newton
+/// iterations (empty when it failed before the first).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{failure}")]
+pub struct FailedAttempt {
+    pub failure: StepFailure,
+    pub residuals: Vec<f64>,
+}
+
+impl From<StepFailure> for FailedAttempt {
+    /// A failure before any Newton iteration.
+    fn from(failure: StepFailure) -> Self {
+        FailedAttempt {
+            failure,
+            residuals: vec![],
+        }
+    }
+}
+
 /// A load step that failed, with the Newton residual history of its last attempt.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[error("load step {step}{}: {failure}; residual history {residuals:?}", cut_note(*.attempts, *.load_factor))]

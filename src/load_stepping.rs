@@ -2,7 +2,8 @@
 //! iGIMP, the FEM comparators) runs, with halving cutbacks of a failing increment and the
 //! record of every attempt. Newton on one increment is [`crate::newton`]'s.
 
-use crate::error::{SolveError, StepFailure};
+use crate::error::FailedAttempt;
+use crate::error::SolveError;
 use crate::newton::{NewtonReport, NewtonSettings};
 use serde::{Deserialize, Serialize};
 
@@ -116,7 +117,7 @@ pub struct Increment {
 pub trait LoadStepping {
     /// Solve one increment from the committed state to the total load factor `load_factor`
     /// and commit it on success. On failure nothing is committed: the solver is as before.
-    fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)>;
+    fn advance(&mut self, load_factor: f64) -> Result<Increment, FailedAttempt>;
     /// Load steps completed so far.
     fn steps_done(&self) -> usize;
     /// Record that nominal step `n` is complete.
@@ -171,7 +172,7 @@ pub trait LoadStepping {
                     current = to;
                     increment = (2.0 * increment).min(nominal);
                 }
-                Err((failure, residuals)) => {
+                Err(FailedAttempt { failure, residuals }) => {
                     let half = 0.5 * (to - current);
                     if half < floor * (1.0 - 1e-9) {
                         return Err(SolveError {

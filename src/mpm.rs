@@ -4,6 +4,7 @@ use crate::assembly::{StartForces, StepInput, StepWorkspace, SupportTable};
 use crate::basis::{Basis, BasisError, BasisFamily, PointSupport};
 use crate::constitutive::ConstitutiveModel;
 use crate::dynamics::{BodyForce, Inertia, Newmark, NewmarkStep, TimeStep};
+use crate::error::FailedAttempt;
 use crate::error::{require_count, InputError, StepFailure};
 use crate::ghost::{cell_fill, node_share, GhostOperator, GhostSettings};
 use crate::grid::Grid;
@@ -675,8 +676,8 @@ impl<const D: usize> MpmSolver<D> {
 }
 
 impl<const D: usize> LoadStepping for MpmSolver<D> {
-    fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
-        let step = self.prepare_step(load_factor).map_err(|f| (f, vec![]))?;
+    fn advance(&mut self, load_factor: f64) -> Result<Increment, FailedAttempt> {
+        let step = self.prepare_step(load_factor).map_err(FailedAttempt::from)?;
         if self.settings.linear_solver == crate::linear::LinearSolver::Iterative
             && self.work.node_geometry.is_none()
         {
@@ -688,7 +689,10 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
         let report = self.work.solve(&input, &self.settings.newton)?;
         let linear = self.work.linear_record(before);
         self.commit(step.time_step.map(|t| t.newmark))
-            .map_err(|f| (f, report.residuals.clone()))?;
+            .map_err(|failure| FailedAttempt {
+                failure,
+                residuals: report.residuals.clone(),
+            })?;
         if let Some(t) = step.time_step {
             self.time = t.end;
         }

@@ -1,5 +1,6 @@
 //! Full Newton–Raphson on the out-of-balance force of one load step (eqs 21–23).
 
+use crate::error::FailedAttempt;
 use crate::error::{require_count, InputError, StepFailure};
 use serde::{Deserialize, Serialize};
 
@@ -147,7 +148,7 @@ pub fn solve(
     system: &mut dyn NonlinearSystem,
     u: &mut [f64],
     settings: &NewtonSettings,
-) -> Result<NewtonReport, (StepFailure, Vec<f64>)> {
+) -> Result<NewtonReport, FailedAttempt> {
     let n = system.num_unknowns();
     let mut r = vec![0.0; n];
     let mut history = Vec::with_capacity(settings.max_iterations.min(64) + 1);
@@ -177,11 +178,17 @@ pub fn solve(
         numerator / scale(system)
     };
     if let Err(f) = system.evaluate(u, &mut r) {
-        return Err((f, history));
+        return Err(FailedAttempt {
+            failure: f,
+            residuals: history,
+        });
     }
     let mut res = measure(system, &r);
     if !res.is_finite() {
-        return Err((StepFailure::NonFinite { iteration: 0 }, history));
+        return Err(FailedAttempt {
+            failure: StepFailure::NonFinite { iteration: 0 },
+            residuals: history,
+        });
     }
     history.push(res);
     let mut delta = vec![0.0; n];
@@ -199,7 +206,10 @@ pub fn solve(
         }
         system.set_linear_tolerance(linear_tolerance(res));
         if let Err(f) = system.solve_tangent(&mut delta) {
-            return Err((f, history));
+            return Err(FailedAttempt {
+                failure: f,
+                residuals: history,
+            });
         }
         // Δd += α δ, eq (23); α = 1 unless the line search backtracks.
         let mut alpha = 1.0;
@@ -218,12 +228,18 @@ pub fn solve(
                         break;
                     }
                     if last_try {
-                        return Err((StepFailure::NonFinite { iteration: it }, history));
+                        return Err(FailedAttempt {
+                            failure: StepFailure::NonFinite { iteration: it },
+                            residuals: history,
+                        });
                     }
                 }
                 Err(f) => {
                     if last_try {
-                        return Err((f, history));
+                        return Err(FailedAttempt {
+                            failure: f,
+                            residuals: history,
+                        });
                     }
                 }
             }
@@ -249,15 +265,18 @@ pub fn solve(
                 });
             }
         }
-        return Err((stall, history));
+        return Err(FailedAttempt {
+            failure: stall,
+            residuals: history,
+        });
     }
-    Err((
-        StepFailure::NotConverged {
+    Err(FailedAttempt {
+        failure: StepFailure::NotConverged {
             iterations: settings.max_iterations,
             last: res,
         },
-        history,
-    ))
+        residuals: history,
+    })
 }
 
 /// A step whose Newton iterations are used up, stalled (`detect_stall`) at a floor within

@@ -14,6 +14,7 @@ use super::updated_lagrangian::{
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::dynamics::{BodyForce, Newmark};
+use crate::error::FailedAttempt;
 use crate::error::{require_finite, InputError, StepFailure};
 use crate::linear::LinearSolver;
 use crate::load_stepping::{Increment, LoadStepping};
@@ -347,7 +348,7 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
 }
 
 impl<const D: usize, E: ElementFamily<D>> LoadStepping for ContinuumFem<D, E> {
-    fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
+    fn advance(&mut self, load_factor: f64) -> Result<Increment, FailedAttempt> {
         // The multigrid coarsens the initial (structured) mesh: its nodes nest in the coarse
         // grids, which the deformed ones need not.
         if self.settings.linear_solver == LinearSolver::Iterative && self.core.work.node_geometry.is_none() {

@@ -66,6 +66,7 @@ pub use updated_lagrangian::{validate_stepping, FemMesh, GaussPoints, MAX_LOAD_S
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::dynamics::Newmark;
+use crate::error::FailedAttempt;
 use crate::error::{require_finite, InputError, StepFailure};
 use crate::load_stepping::{Increment, LoadStepping};
 use crate::newton::NewtonSettings;
@@ -245,7 +246,7 @@ impl LineFem {
 }
 
 impl LoadStepping for LineFem {
-    fn advance(&mut self, load_factor: f64) -> Result<Increment, (StepFailure, Vec<f64>)> {
+    fn advance(&mut self, load_factor: f64) -> Result<Increment, FailedAttempt> {
         fem_advance(
             &mut self.core,
             &mut self.mesh,

@@ -7,6 +7,7 @@
 use crate::assembly::{LoadStepSystem, StartForces, StepInput, StepWorkspace, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::dynamics::{BodyForce, Inertia, Newmark, TimeStep};
+use crate::error::FailedAttempt;
 use crate::error::{require_count, InputError, StepFailure};
 use crate::kinematics::PointState;
 use crate::load_stepping::Increment;
@@ -267,17 +268,17 @@ impl<const D: usize> UlCore<D> {
         num_nodes: usize,
         loads: &FullLoads<'_, D>,
         build_supports: impl FnOnce(&mut SupportTable<D>) -> Result<(), StepFailure>,
-    ) -> Result<Increment, (StepFailure, Vec<f64>)> {
+    ) -> Result<Increment, FailedAttempt> {
         crate::profile::timed(crate::profile::Phase::Weights, || {
             build_supports(&mut self.work.table)
         })
-        .map_err(|f| (f, vec![]))?;
+        .map_err(FailedAttempt::from)?;
         let before = self.work.matrix.stats().iterations;
         let report = self
             .with_input(states, num_nodes, loads, load_factor, |work, input| {
                 work.solve(input, newton)
             })
-            .map_err(|f| (f, vec![]))??;
+            .map_err(FailedAttempt::from)??;
         self.work.commit_states(states);
         self.commit_motion();
         Ok(Increment {
@@ -319,7 +320,7 @@ pub(crate) fn fem_advance<const D: usize, M: FemMesh<D>>(
     dof_forces: &[(usize, f64)],
     newton: &NewtonSettings,
     load_factor: f64,
-) -> Result<Increment, (StepFailure, Vec<f64>)> {
+) -> Result<Increment, FailedAttempt> {
     let loads = FullLoads {
         gravity,
         mass: &gauss.mass,
