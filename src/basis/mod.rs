@@ -401,23 +401,63 @@ impl<const D: usize, K: AxisKernel> BasisFamily<D> for TensorProduct<K> {
     }
 }
 
-/// Which basis family a material point solver uses. The serialised names are the families'
-/// method names apart from GIMP's (`gimp`; the method is `igimp`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize, Hash)]
-#[serde(rename_all = "lowercase")]
-pub enum Basis {
-    /// Standard MPM: linear shape functions evaluated at the point, χ_p = δ V_p (eq 5).
-    Mpm,
-    /// GIMP with a top-hat characteristic function (eq 6), split per element (eqs 7–10).
-    Gimp,
-    /// CPDI2: corner-tracked multilinear domains ([`cpdi`]).
-    Cpdi,
-    /// Quadratic B-splines, boundary nodes by linear extrapolation ([`bspline`]).
-    Bspline2,
-    /// Cubic B-splines, boundary nodes by linear extrapolation ([`bspline`]).
-    Bspline3,
-    /// Total-Lagrangian MPM: linear hats in the reference configuration ([`total_lagrangian`]).
-    Tlmpm,
+/// Declares the basis families once: the [`Basis`] enum, [`Basis::ALL`], and each family's
+/// implementation, axis kernel, method name and label follow from one row per family, so that
+/// a new in-crate family is its own file and one row here.
+macro_rules! basis_families {
+    ($(
+        $(#[$doc:meta])*
+        $variant:ident => $imp:expr, axis $axis:expr, method $method:literal, label $label:literal;
+    )*) => {
+        /// Which basis family a material point solver uses. The serialised names are the
+        /// families' method names apart from GIMP's (`gimp`; the method is `igimp`).
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize, Hash)]
+        #[serde(rename_all = "lowercase")]
+        pub enum Basis {
+            $($(#[$doc])* $variant,)*
+        }
+
+        impl Basis {
+            /// Every family, in declaration order.
+            pub const ALL: [Basis; [$(stringify!($variant)),*].len()] = [$(Basis::$variant),*];
+
+            /// The family's implementation in `D` dimensions.
+            pub fn family<const D: usize>(self) -> &'static dyn BasisFamily<D> {
+                match self {
+                    $(Basis::$variant => &$imp,)*
+                }
+            }
+
+            /// [`Self::family`] as a shared value, the form the solver holds (it also holds
+            /// families defined outside the crate).
+            pub fn shared<const D: usize>(self) -> std::sync::Arc<dyn BasisFamily<D>> {
+                match self {
+                    $(Basis::$variant => std::sync::Arc::new($imp),)*
+                }
+            }
+
+            /// The axis kernel of a tensor-product family; `None` for CPDI and TLMPM.
+            pub fn axis_kernel(self) -> Option<&'static dyn AxisKernel> {
+                match self {
+                    $(Basis::$variant => $axis,)*
+                }
+            }
+
+            /// The name of the method in study files and `results.json`.
+            pub fn method_name(self) -> &'static str {
+                match self {
+                    $(Basis::$variant => $method,)*
+                }
+            }
+
+            /// The human name.
+            pub fn label(self) -> &'static str {
+                match self {
+                    $(Basis::$variant => $label,)*
+                }
+            }
+        }
+    };
 }
 
 const MPM: TensorProduct<LinearKernel> = TensorProduct(LinearKernel);
@@ -432,77 +472,22 @@ const BSPLINE3: TensorProduct<BsplineKernel> = TensorProduct(BsplineKernel {
 });
 const TLMPM: TotalLagrangian<TensorProduct<LinearKernel>> = TotalLagrangian(TensorProduct(LinearKernel));
 
+basis_families! {
+    /// Standard MPM: linear shape functions evaluated at the point, χ_p = δ V_p (eq 5).
+    Mpm => MPM, axis Some(&LinearKernel), method "mpm", label "MPM";
+    /// GIMP with a top-hat characteristic function (eq 6), split per element (eqs 7–10).
+    Gimp => GIMP, axis Some(&GimpKernel), method "igimp", label "iGIMP";
+    /// CPDI2: corner-tracked multilinear domains ([`cpdi`]).
+    Cpdi => Cpdi, axis None, method "cpdi", label "CPDI2";
+    /// Quadratic B-splines, boundary nodes by linear extrapolation ([`bspline`]).
+    Bspline2 => BSPLINE2, axis Some(&BSPLINE2.0), method "bspline2", label "quadratic B-spline MPM";
+    /// Cubic B-splines, boundary nodes by linear extrapolation ([`bspline`]).
+    Bspline3 => BSPLINE3, axis Some(&BSPLINE3.0), method "bspline3", label "cubic B-spline MPM";
+    /// Total-Lagrangian MPM: linear hats in the reference configuration ([`total_lagrangian`]).
+    Tlmpm => TLMPM, axis None, method "tlmpm", label "TLMPM";
+}
+
 impl Basis {
-    /// Every family, in declaration order.
-    pub const ALL: [Basis; 6] = [
-        Basis::Mpm,
-        Basis::Gimp,
-        Basis::Cpdi,
-        Basis::Bspline2,
-        Basis::Bspline3,
-        Basis::Tlmpm,
-    ];
-
-    /// The family's implementation in `D` dimensions.
-    pub fn family<const D: usize>(self) -> &'static dyn BasisFamily<D> {
-        match self {
-            Basis::Mpm => &MPM,
-            Basis::Gimp => &GIMP,
-            Basis::Cpdi => &Cpdi,
-            Basis::Bspline2 => &BSPLINE2,
-            Basis::Bspline3 => &BSPLINE3,
-            Basis::Tlmpm => &TLMPM,
-        }
-    }
-
-    /// [`Self::family`] as a shared value, the form the solver holds (it also holds families
-    /// defined outside the crate).
-    pub fn shared<const D: usize>(self) -> std::sync::Arc<dyn BasisFamily<D>> {
-        match self {
-            Basis::Mpm => std::sync::Arc::new(MPM),
-            Basis::Gimp => std::sync::Arc::new(GIMP),
-            Basis::Cpdi => std::sync::Arc::new(Cpdi),
-            Basis::Bspline2 => std::sync::Arc::new(BSPLINE2),
-            Basis::Bspline3 => std::sync::Arc::new(BSPLINE3),
-            Basis::Tlmpm => std::sync::Arc::new(TLMPM),
-        }
-    }
-
-    /// The axis kernel of a tensor-product family; `None` for CPDI and TLMPM.
-    pub fn axis_kernel(self) -> Option<&'static dyn AxisKernel> {
-        match self {
-            Basis::Mpm => Some(&LinearKernel),
-            Basis::Gimp => Some(&GimpKernel),
-            Basis::Bspline2 => Some(&BSPLINE2.0),
-            Basis::Bspline3 => Some(&BSPLINE3.0),
-            Basis::Cpdi | Basis::Tlmpm => None,
-        }
-    }
-
-    /// The name of the method in study files and `results.json`.
-    pub fn method_name(self) -> &'static str {
-        match self {
-            Basis::Mpm => "mpm",
-            Basis::Gimp => "igimp",
-            Basis::Cpdi => "cpdi",
-            Basis::Bspline2 => "bspline2",
-            Basis::Bspline3 => "bspline3",
-            Basis::Tlmpm => "tlmpm",
-        }
-    }
-
-    /// The human name.
-    pub fn label(self) -> &'static str {
-        match self {
-            Basis::Mpm => "MPM",
-            Basis::Gimp => "iGIMP",
-            Basis::Cpdi => "CPDI2",
-            Basis::Bspline2 => "quadratic B-spline MPM",
-            Basis::Bspline3 => "cubic B-spline MPM",
-            Basis::Tlmpm => "TLMPM",
-        }
-    }
-
     /// True if the family's weights depend on the domain half-lengths, and so on the domain
     /// update rule (GIMP only; CPDI's domains follow their corners).
     pub fn uses_domain_update(self) -> bool {
