@@ -11,31 +11,8 @@ use serde_json::Value;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-/// Three small column cases (iGIMP, MPM, quadratic FEM).
-const TINY: &str = r#"
-schema = 1
-name = "tiny"
-summary = "three small column cases"
-problem = "column"
-report_file = "table.md"
-load_steps = 4
-[column]
-length = 50.0
-young_modulus = 1.0e6
-poisson_ratio = 0.0
-density = 80.0
-yield_stress = 20000.0
-[newton]
-tolerance = 1.0e-9
-max_iterations = 30
-[[sweeps]]
-id = "a"
-title = "small cases"
-methods = ["igimp", "mpm", "fem-quadratic"]
-weights = [40000.0]
-elements = [8]
-points_per_cell = [2]
-"#;
+// Three small column cases (iGIMP, MPM, quadratic FEM), shared with `usability`.
+use crate::usability::TINY;
 
 /// The iGIMP case of `TINY`, whose record the tests tamper with.
 const IGIMP: &str = "igimp-w40000-e8-p2-s4";

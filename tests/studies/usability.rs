@@ -14,8 +14,9 @@ fn study_bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_study"))
 }
 
-/// A column study with three small cases (iGIMP, MPM, quadratic FEM).
-const TINY: &str = r#"
+/// A column study with three small cases (iGIMP, MPM, quadratic FEM); `resume` tampers with
+/// their records.
+pub(crate) const TINY: &str = r#"
 schema = 1
 name = "tiny"
 summary = "three small column cases"
