@@ -26,6 +26,7 @@ pub enum Element {
 }
 
 impl Element {
+    /// Every element, in declaration order.
     pub const ALL: [Element; 6] = [
         Element::Line2,
         Element::Line3,
@@ -36,7 +37,7 @@ impl Element {
     ];
 
     /// The space dimension the element discretises.
-    pub fn dimension(self) -> usize {
+    pub const fn dimension(self) -> usize {
         match self {
             Element::Line2 | Element::Line3 => 1,
             Element::Q4 | Element::Q8 => 2,
@@ -75,30 +76,64 @@ impl Method {
     pub const FEM_HEX20: Method = Method::Fem(Element::Hex20);
 
     /// Every method: the material point families, then the elements.
-    pub const ALL: [Method; 12] = [
-        Method::MPM,
-        Method::IGIMP,
-        Method::CPDI,
-        Method::BSPLINE2,
-        Method::BSPLINE3,
-        Method::TLMPM,
-        Method::FEM_LINEAR,
-        Method::FEM_QUADRATIC,
-        Method::FEM_Q4,
-        Method::FEM_Q8,
-        Method::FEM_HEX8,
-        Method::FEM_HEX20,
-    ];
+    pub const ALL: [Method; Basis::ALL.len() + Element::ALL.len()] = Method::listed(None, &[]);
 
     /// The material point methods, one per basis family.
-    pub const MATERIAL_POINT: [Method; 6] = [
-        Method::MPM,
-        Method::IGIMP,
-        Method::CPDI,
-        Method::BSPLINE2,
-        Method::BSPLINE3,
-        Method::TLMPM,
-    ];
+    pub const MATERIAL_POINT: [Method; Basis::ALL.len()] = {
+        let mut out = [Method::MPM; Basis::ALL.len()];
+        let mut i = 0;
+        while i < out.len() {
+            out[i] = Method::MaterialPoint(Basis::ALL[i]);
+            i += 1;
+        }
+        out
+    };
+
+    /// A problem's methods, derived from the one declaration of each family ([`Basis::ALL`])
+    /// and element ([`Element::ALL`]): every material point family, then the elements of
+    /// `dimension` (every element if `None`), less `excluded`, in declaration order. `N` is
+    /// their count; a wrong one is a compile-time error.
+    pub const fn listed<const N: usize>(dimension: Option<usize>, excluded: &[Method]) -> [Method; N] {
+        let mut out = [Method::MPM; N];
+        let mut k = 0;
+        let mut i = 0;
+        while i < Basis::ALL.len() + Element::ALL.len() {
+            let m = if i < Basis::ALL.len() {
+                Method::MaterialPoint(Basis::ALL[i])
+            } else {
+                Method::Fem(Element::ALL[i - Basis::ALL.len()])
+            };
+            let of_dimension = match (m, dimension) {
+                (Method::Fem(e), Some(d)) => e.dimension() == d,
+                _ => true,
+            };
+            let mut kept = of_dimension;
+            let mut j = 0;
+            while j < excluded.len() {
+                if m.same_as(excluded[j]) {
+                    kept = false;
+                }
+                j += 1;
+            }
+            if kept {
+                assert!(k < N, "more methods than N");
+                out[k] = m;
+                k += 1;
+            }
+            i += 1;
+        }
+        assert!(k == N, "fewer methods than N");
+        out
+    }
+
+    /// `==` in a const context.
+    const fn same_as(self, other: Method) -> bool {
+        match (self, other) {
+            (Method::MaterialPoint(a), Method::MaterialPoint(b)) => a as u8 == b as u8,
+            (Method::Fem(a), Method::Fem(b)) => a as u8 == b as u8,
+            _ => false,
+        }
+    }
 
     /// The name in study files and `results.json`.
     pub fn name(self) -> &'static str {

@@ -384,28 +384,10 @@ fn run_fem_block<const D: usize, E: ElementFamily<D>>(
 }
 
 /// The methods that solve the plane-strain compaction.
-pub const METHODS: [Method; 8] = [
-    Method::IGIMP,
-    Method::MPM,
-    Method::CPDI,
-    Method::BSPLINE2,
-    Method::BSPLINE3,
-    Method::TLMPM,
-    Method::FEM_Q4,
-    Method::FEM_Q8,
-];
+pub const METHODS: [Method; 8] = Method::listed(Some(2), &[]);
 
 /// The methods that solve the 3D compaction.
-pub const METHODS_3D: [Method; 8] = [
-    Method::IGIMP,
-    Method::MPM,
-    Method::CPDI,
-    Method::BSPLINE2,
-    Method::BSPLINE3,
-    Method::TLMPM,
-    Method::FEM_HEX8,
-    Method::FEM_HEX20,
-];
+pub const METHODS_3D: [Method; 8] = Method::listed(Some(3), &[]);
 
 /// The methods of a compaction in `dimension` (2 or 3).
 pub fn methods(dimension: usize) -> &'static [Method] {

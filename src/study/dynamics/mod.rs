@@ -462,16 +462,7 @@ pub struct CaseLevels {
 }
 
 /// The methods a bar case can use: every material point family and the line elements.
-pub const BAR_METHODS: [Method; 8] = [
-    Method::MPM,
-    Method::IGIMP,
-    Method::CPDI,
-    Method::BSPLINE2,
-    Method::BSPLINE3,
-    Method::TLMPM,
-    Method::FEM_LINEAR,
-    Method::FEM_QUADRATIC,
-];
+pub const BAR_METHODS: [Method; 8] = Method::listed(Some(1), &[]);
 
 /// The methods of a plane manufactured case: every material point family, Q4 and Q8.
 pub const MANUFACTURED_METHODS: [Method; 8] = manufactured_dynamic::METHODS;
