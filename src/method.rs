@@ -75,6 +75,10 @@ impl Method {
     pub const FEM_HEX8: Method = Method::Fem(Element::Hex8);
     pub const FEM_HEX20: Method = Method::Fem(Element::Hex20);
 
+    /// How many material point families there are ([`Basis::ALL`]): problem method lists are
+    /// sized by it, so that a new family joins them without an edit.
+    pub const FAMILIES: usize = Basis::ALL.len();
+
     /// Every method: the material point families, then the elements.
     pub const ALL: [Method; Basis::ALL.len() + Element::ALL.len()] = Method::listed(None, &[]);
 

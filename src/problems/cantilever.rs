@@ -653,10 +653,10 @@ fn run_fem<const D: usize, E: ElementFamily<D>>(
 
 /// The methods that solve the plane-strain cantilever (its FEM comparator is Q8, the paper's
 /// Figure 21).
-pub const METHODS: [Method; 7] = Method::listed(Some(2), &[Method::FEM_Q4]);
+pub const METHODS: [Method; Method::FAMILIES + 1] = Method::listed(Some(2), &[Method::FEM_Q4]);
 
 /// The methods that solve the 3D cantilever.
-pub const METHODS_3D: [Method; 8] = Method::listed(Some(3), &[]);
+pub const METHODS_3D: [Method; Method::FAMILIES + 2] = Method::listed(Some(3), &[]);
 
 /// The methods of a cantilever in `dimension` (2 or 3).
 pub fn methods(dimension: usize) -> &'static [Method] {

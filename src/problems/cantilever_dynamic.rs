@@ -159,7 +159,7 @@ impl DynamicCantileverSpec {
 }
 
 /// The methods that solve the dynamic cantilever.
-pub const METHODS: [Method; 7] = crate::problems::cantilever::METHODS;
+pub const METHODS: [Method; Method::FAMILIES + 1] = crate::problems::cantilever::METHODS;
 
 /// Solve one analysis.
 pub fn solve(spec: &DynamicCantileverSpec, method: Method) -> Result<DynamicCantileverOutcome, InputError> {

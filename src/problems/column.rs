@@ -253,10 +253,10 @@ pub fn f_from_cauchy_stress(s: f64) -> f64 {
 pub use crate::method::Method;
 
 /// The methods that solve the column.
-pub const METHODS: [Method; 8] = Method::listed(Some(1), &[]);
+pub const METHODS: [Method; Method::FAMILIES + 2] = Method::listed(Some(1), &[]);
 
 /// The methods that solve the 3D column (`dimension = 3`).
-pub const METHODS_3D: [Method; 8] = Method::listed(Some(3), &[]);
+pub const METHODS_3D: [Method; Method::FAMILIES + 2] = Method::listed(Some(3), &[]);
 
 /// The column problem's parameters (defaults: §5.1 with W = 40,000).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

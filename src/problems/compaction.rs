@@ -384,10 +384,10 @@ fn run_fem_block<const D: usize, E: ElementFamily<D>>(
 }
 
 /// The methods that solve the plane-strain compaction.
-pub const METHODS: [Method; 8] = Method::listed(Some(2), &[]);
+pub const METHODS: [Method; Method::FAMILIES + 2] = Method::listed(Some(2), &[]);
 
 /// The methods that solve the 3D compaction.
-pub const METHODS_3D: [Method; 8] = Method::listed(Some(3), &[]);
+pub const METHODS_3D: [Method; Method::FAMILIES + 2] = Method::listed(Some(3), &[]);
 
 /// The methods of a compaction in `dimension` (2 or 3).
 pub fn methods(dimension: usize) -> &'static [Method] {

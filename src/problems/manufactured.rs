@@ -55,7 +55,7 @@ impl Field {
 }
 
 /// The methods that solve the manufactured problem.
-pub const METHODS: [Method; 8] = Method::listed(Some(2), &[]);
+pub const METHODS: [Method; Method::FAMILIES + 2] = Method::listed(Some(2), &[]);
 
 /// One manufactured-solution analysis.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

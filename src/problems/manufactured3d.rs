@@ -33,7 +33,7 @@ use std::f64::consts::PI;
 type V3 = SVector<f64, 3>;
 
 /// The methods that solve the 3D manufactured problem.
-pub const METHODS_3D: [Method; 8] = Method::listed(Some(3), &[]);
+pub const METHODS_3D: [Method; Method::FAMILIES + 2] = Method::listed(Some(3), &[]);
 
 /// F = diag(F₂(X, Y), f₃₃(Z)) of the 3D fields.
 fn block_gradient<T: DualNum<Primitive = f64> + Copy>(field: Field, a: f64, x: [T; 3]) -> (M2<T>, T) {

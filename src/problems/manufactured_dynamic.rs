@@ -45,7 +45,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// The methods that solve the dynamic manufactured problem.
-pub const METHODS: [Method; 8] = super::manufactured::METHODS;
+pub const METHODS: [Method; Method::FAMILIES + 2] = super::manufactured::METHODS;
 
 /// One dynamic manufactured analysis.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -462,14 +462,15 @@ pub struct CaseLevels {
 }
 
 /// The methods a bar case can use: every material point family and the line elements.
-pub const BAR_METHODS: [Method; 8] = Method::listed(Some(1), &[]);
+pub const BAR_METHODS: [Method; Method::FAMILIES + 2] = Method::listed(Some(1), &[]);
 
 /// The methods of a plane manufactured case: every material point family, Q4 and Q8.
-pub const MANUFACTURED_METHODS: [Method; 8] = manufactured_dynamic::METHODS;
+pub const MANUFACTURED_METHODS: [Method; Method::FAMILIES + 2] = manufactured_dynamic::METHODS;
 /// The methods of a 3D manufactured case: every material point family, Hex8 and Hex20.
-pub const MANUFACTURED_METHODS_3D: [Method; 8] = crate::problems::manufactured3d::METHODS_3D;
+pub const MANUFACTURED_METHODS_3D: [Method; Method::FAMILIES + 2] =
+    crate::problems::manufactured3d::METHODS_3D;
 /// The methods of a dynamic cantilever case: every material point family and Q8.
-pub const CANTILEVER_METHODS: [Method; 7] = crate::problems::cantilever_dynamic::METHODS;
+pub const CANTILEVER_METHODS: [Method; Method::FAMILIES + 1] = crate::problems::cantilever_dynamic::METHODS;
 
 /// Most elements of one case (1D: cheap; a bound against typos).
 const MAX_ELEMENTS: i64 = 65_536;
