@@ -117,20 +117,19 @@ pub trait StudyKind: Serialize + DeserializeOwned + Clone + Sync {
     /// No sweep lists a value twice (it would name one case twice, solved once).
     fn check_sweeps_distinct(&self, file: &str, text: &str) -> Result<(), StudyError> {
         let chk = super::vocabulary::Checker { file };
-        let order: Vec<String> = text
-            .parse::<toml::Table>()
-            .ok()
-            .and_then(|t| t.get("sweeps")?.as_array().cloned())
-            .unwrap_or_default()
-            .iter()
-            .map(|s| s.get("id").and_then(|v| v.as_str()).unwrap_or("").to_string())
-            .collect();
         for tier in [Tier::Full, Tier::Quick] {
             let (_, index) = self.cases(tier);
             for (sweep, ids) in &index {
                 let mut seen = std::collections::BTreeSet::new();
                 if let Some(twice) = ids.iter().find(|id| !seen.insert(id.as_str())) {
-                    let key = match order.iter().position(|s| s == sweep) {
+                    // The sweep's index in the file, read only for the error.
+                    let position = text.parse::<toml::Table>().ok().and_then(|t| {
+                        t.get("sweeps")?
+                            .as_array()?
+                            .iter()
+                            .position(|s| s.get("id").and_then(|v| v.as_str()) == Some(sweep.as_str()))
+                    });
+                    let key = match position {
                         Some(i) => format!("sweeps[{i}]"),
                         None => format!("sweep {sweep:?}"),
                     };

@@ -97,10 +97,13 @@ fn line_at(text: &str, offset: usize) -> usize {
 /// The line of `key` in `text`, or of the deepest section of it that the file has; `None`
 /// if the text does not parse or the key is not a path.
 pub fn line_of(text: &str, key: &str) -> Option<usize> {
-    let doc = ImDocument::parse(text).ok()?;
-    let path = steps(key)?;
-    let (_, span) = walk(&doc, &path);
-    span.map(|s| line_at(text, s.start))
+    line_in(&ImDocument::parse(text).ok()?, key)
+}
+
+/// [`line_of`] in the parsed document.
+fn line_in(doc: &ImDocument<&str>, key: &str) -> Option<usize> {
+    let (_, span) = walk(doc, &steps(key)?);
+    span.map(|s| line_at(doc.raw(), s.start))
 }
 
 /// Does the file have `key`?
@@ -128,39 +131,26 @@ fn resolve_exact(doc: &ImDocument<&str>, scope: &str, field: &str) -> Option<Str
     let head_end = field.find(['.', '[']).unwrap_or(field.len());
     let (head, rest) = field.split_at(head_end);
     let names = [format!("{head}{rest}"), format!("{head}s{rest}")];
-    let mut scopes: Vec<String> = vec![];
-    let mut s = scope.to_string();
-    while !s.is_empty() {
-        scopes.push(s.clone());
-        s = match s.rfind('.') {
-            Some(i) => s[..i].to_string(),
-            None => String::new(),
-        };
-    }
-    scopes.push(String::new());
-    for scope in &scopes {
-        for n in &names {
+    // `sweeps[0].quick`, `sweeps[0]`, the top level, then each section of the file.
+    let scopes = std::iter::successors(Some(scope), |s| s.rfind('.').map(|i| &s[..i]))
+        .filter(|s| !s.is_empty())
+        .chain([""])
+        .map(str::to_string);
+    let sections = doc
+        .as_table()
+        .iter()
+        .filter(|(_, item)| item.is_table_like())
+        .map(|(section, _)| section.to_string());
+    scopes.chain(sections).find_map(|scope| {
+        names.iter().find_map(|n| {
             let key = if scope.is_empty() {
                 n.clone()
             } else {
                 format!("{scope}.{n}")
             };
-            if has(doc, &key) {
-                return Some(key);
-            }
-        }
-    }
-    for (section, item) in doc.as_table().iter() {
-        if item.is_table_like() {
-            for n in &names {
-                let key = format!("{section}.{n}");
-                if has(doc, &key) {
-                    return Some(key);
-                }
-            }
-        }
-    }
-    None
+            has(doc, &key).then_some(key)
+        })
+    })
 }
 
 /// `err` with the key as the file writes it ([`StudyError::CaseInput`] resolved) and the line
@@ -191,7 +181,7 @@ pub fn locate(text: &str, err: StudyError) -> StudyError {
         } => (file, key, value, allowed),
         other => return other,
     };
-    let file = match line_of(text, &key) {
+    let file = match doc.as_ref().and_then(|d| line_in(d, &key)) {
         Some(line) => format!("{file}:{line}"),
         None => file,
     };
