@@ -33,6 +33,30 @@ pub fn require_time_steps(
     ))
 }
 
+/// The time scales of a dynamic analysis of `periods` periods of `period` at
+/// `steps_per_period`: at most [`MAX_LOAD_STEPS`] steps ([`require_time_steps`]), and the
+/// period, the duration and the time step finite, positive and normal
+/// ([`crate::error::require_derived`]). `periods` is the periods' key and value; `from` the
+/// input the period derives from (its key and value) and how, for the message.
+pub fn require_time_scales(
+    periods: (&str, f64),
+    steps_per_period: usize,
+    period: f64,
+    from: (&str, f64, &str),
+) -> Result<(), crate::error::InputError> {
+    require_time_steps(periods.0, periods.1, steps_per_period)?;
+    let duration = periods.1 * period;
+    let steps = (periods.1 * steps_per_period as f64).round().max(1.0);
+    for (what, v) in [
+        ("period", period),
+        ("duration", duration),
+        ("time step", duration / steps),
+    ] {
+        crate::error::require_derived(from.0, from.1, &format!("the {what} {}", from.2), v)?;
+    }
+    Ok(())
+}
+
 /// The steps of a run and its failure, if any: the form the problems record a run in,
 /// whether it converged or stopped at a failing step.
 pub fn steps_and_failure(

@@ -16,7 +16,7 @@
 use crate::basis::DomainUpdate;
 use crate::constitutive::LinearElastic;
 use crate::dynamics::{LoadHistory, MassMatrix, Newmark};
-use crate::error::{require_count, require_derived, require_positive, InputError, SolveError};
+use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
 use crate::grid::Grid;
 use crate::kinematics::{log_strain, PointState};
@@ -132,17 +132,13 @@ impl BarSpec {
         require_count("bar.points_per_cell", self.points_per_cell, 1)?;
         require_count("bar.steps_per_period", self.steps_per_period, 1)?;
         require_positive("bar.periods", self.periods)?;
-        crate::load_stepping::require_time_steps("bar.periods", self.periods, self.steps_per_period)?;
         // The closed form's scales, derived from L, E and ρ.
-        require_derived("bar.length", self.length, "the period T = 4L/c", self.period())?;
-        require_derived(
-            "bar.length",
-            self.length,
-            "the duration periods × T",
-            self.duration(),
+        crate::load_stepping::require_time_scales(
+            ("bar.periods", self.periods),
+            self.steps_per_period,
+            self.period(),
+            ("bar.length", self.length, "(T = 4L/c)"),
         )?;
-        let dt = self.period() / self.steps_per_period as f64;
-        require_derived("bar.length", self.length, "the time step T/steps_per_period", dt)?;
         crate::error::require_finite("bar.velocity", self.velocity / self.omega())?;
         self.newmark().validate()
     }

@@ -18,7 +18,7 @@
 //! for this one.
 
 use crate::dynamics::{LoadHistory, MassMatrix, Newmark};
-use crate::error::{require_count, require_derived, require_positive, InputError, SolveError};
+use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::fem::{ElementFamily, PlaneFem};
 use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
 use crate::method::Method;
@@ -71,27 +71,16 @@ impl DynamicCantileverSpec {
         require_positive("cantilever.density", self.density)?;
         require_positive("cantilever.periods", self.periods)?;
         require_count("cantilever.steps_per_period", self.steps_per_period, 1)?;
-        crate::load_stepping::require_time_steps("cantilever.periods", self.periods, self.steps_per_period)?;
         // The time scales derived from the beam and ρ, before the Newmark settings see them.
-        let from = "(from the beam's E, ν, depth and length and ρ)";
-        require_derived(
-            "cantilever.density",
-            self.density,
-            &format!("the first period T1 {from}"),
+        crate::load_stepping::require_time_scales(
+            ("cantilever.periods", self.periods),
+            self.steps_per_period,
             self.period(),
-        )?;
-        require_derived(
-            "cantilever.density",
-            self.density,
-            &format!("the duration {from}"),
-            self.duration(),
-        )?;
-        let dt = self.duration() / self.time_steps() as f64;
-        require_derived(
-            "cantilever.density",
-            self.density,
-            &format!("the time step {from}"),
-            dt,
+            (
+                "cantilever.density",
+                self.density,
+                "(from the beam's E, ν, depth and length and ρ)",
+            ),
         )?;
         self.newmark().validate()?;
         self.stepped_beam().validate()

@@ -28,7 +28,7 @@ use super::manufactured3d::{errors_3d, point_values_3d, Exact3, Solution3, METHO
 use crate::basis::DomainUpdate;
 use crate::constitutive::{lame, LinearElastic};
 use crate::dynamics::{BodyForce, LoadHistory, MassMatrix, Newmark};
-use crate::error::{require_count, require_derived, require_positive, InputError};
+use crate::error::{require_count, require_positive, InputError};
 use crate::fem::{
     ContinuumFem, ElementFamily, ElementMesh, FemLoads, HexElement, HexMesh, PlaneFemSettings, PlaneMesh,
     QuadElement,
@@ -135,23 +135,15 @@ impl DynamicManufacturedSpec {
         // field's checks (below).
         require_count("steps_per_period", self.steps_per_period, 1)?;
         require_positive("periods", self.periods)?;
+        // The step count first: the static spec's checks read it as `load_steps`.
         crate::load_stepping::require_time_steps("periods", self.periods, self.steps_per_period)?;
         self.static_spec().validate()?;
-        let from = "(T = 2/c, c = √(E/ρ0))";
-        require_derived(
-            "density",
-            self.density,
-            &format!("the period {from}"),
+        crate::load_stepping::require_time_scales(
+            ("periods", self.periods),
+            self.steps_per_period,
             self.period(),
+            ("density", self.density, "(T = 2/c, c = √(E/ρ0))"),
         )?;
-        require_derived(
-            "density",
-            self.density,
-            &format!("the duration {from}"),
-            self.duration(),
-        )?;
-        let dt = self.duration() / self.time_steps() as f64;
-        require_derived("density", self.density, &format!("the time step {from}"), dt)?;
         self.newmark().validate()
     }
 
