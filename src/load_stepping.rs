@@ -2,8 +2,7 @@
 //! iGIMP, the FEM comparators) runs, with halving cutbacks of a failing increment and the
 //! record of every attempt. Newton on one increment is [`crate::newton`]'s.
 
-use crate::error::FailedAttempt;
-use crate::error::SolveError;
+use crate::error::{FailedAttempt, SolveError};
 use crate::newton::{NewtonReport, NewtonSettings};
 use serde::{Deserialize, Serialize};
 

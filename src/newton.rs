@@ -1,7 +1,6 @@
 //! Full Newton–Raphson on the out-of-balance force of one load step (eqs 21–23).
 
-use crate::error::FailedAttempt;
-use crate::error::{require_count, InputError, StepFailure};
+use crate::error::{require_count, FailedAttempt, InputError, StepFailure};
 use serde::{Deserialize, Serialize};
 
 /// Upper bound of [`NewtonSettings::max_iterations`]: far beyond any useful Newton run, and

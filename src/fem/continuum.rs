@@ -14,8 +14,7 @@ use super::updated_lagrangian::{
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::dynamics::{BodyForce, Newmark};
-use crate::error::FailedAttempt;
-use crate::error::{require_finite, InputError, StepFailure};
+use crate::error::{require_finite, FailedAttempt, InputError, StepFailure};
 use crate::linear::LinearSolver;
 use crate::load_stepping::{Increment, LoadStepping};
 use crate::newton::NewtonSettings;

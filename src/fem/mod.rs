@@ -66,8 +66,7 @@ pub use updated_lagrangian::{validate_stepping, FemMesh, GaussPoints, MAX_LOAD_S
 use crate::assembly::{LoadStepSystem, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::dynamics::Newmark;
-use crate::error::FailedAttempt;
-use crate::error::{require_finite, InputError, StepFailure};
+use crate::error::{require_finite, FailedAttempt, InputError, StepFailure};
 use crate::load_stepping::{Increment, LoadStepping};
 use crate::newton::NewtonSettings;
 use crate::quadrature::GaussRule;

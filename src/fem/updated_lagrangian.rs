@@ -7,8 +7,7 @@
 use crate::assembly::{LoadStepSystem, StartForces, StepInput, StepWorkspace, SupportTable};
 use crate::constitutive::ConstitutiveModel;
 use crate::dynamics::{BodyForce, Inertia, Newmark, TimeStep};
-use crate::error::FailedAttempt;
-use crate::error::{require_count, InputError, StepFailure};
+use crate::error::{require_count, FailedAttempt, InputError, StepFailure};
 use crate::kinematics::PointState;
 use crate::load_stepping::Increment;
 use crate::newton::NewtonSettings;

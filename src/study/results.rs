@@ -412,8 +412,12 @@ impl Failures {
     /// One line for the terminal: which failures were expected and why (the reasons, each
     /// once), and which were not.
     pub fn line(&self) -> Option<String> {
-        let mut reasons: Vec<&str> = self.expected.iter().map(|e| e.1.as_str()).collect();
-        reasons.dedup();
+        let mut reasons: Vec<&str> = vec![];
+        for (_, r) in &self.expected {
+            if !reasons.contains(&r.as_str()) {
+                reasons.push(r);
+            }
+        }
         let mut parts = vec![];
         if !self.expected.is_empty() {
             parts.push(format!(
