@@ -13,11 +13,11 @@
 #[allow(dead_code)]
 mod scaling;
 
-use igimp::linear::LinearSolver;
-use igimp::load_stepping::LoadStepping;
-use igimp::method::Method;
+use igimp::basis::method::Method;
 use igimp::problems::manufactured::{self, ManufacturedSpec};
 use igimp::problems::manufactured_dynamic::{self, DynamicManufacturedSpec};
+use igimp::solver::linear::LinearSolver;
+use igimp::solver::load_stepping::LoadStepping;
 use std::time::Instant;
 
 /// (seconds of the second step, its Newton iterations) of `solver`.

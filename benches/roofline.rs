@@ -14,10 +14,10 @@
 //! assembly's time less that of the points' constitutive tangents (timed alone) against the
 //! bound of the kernel's own flops and the same bytes.
 //!
-//! Counts, per point with m support nodes in D dimensions (src/assembly.rs,
+//! Counts, per point with m support nodes in D dimensions (src/discretise/assembly.rs,
 //! `assemble_tangent`): spatial gradients 2 m D² flops; per column (b, k) of the local block
 //! the D × D product C = a G_b V (2 D³ + D² flops) and the column m D × D dot products
-//! (2 m D² flops); the point's spatial tangent a_ijkl (src/kinematics.rs,
+//! (2 m D² flops); the point's spatial tangent a_ijkl (src/material/kinematics.rs,
 //! `spatial_tangent_eigen`, the elastic model's constant D^alg): the divided differences of
 //! ln (6 × 3 + 3 × 2 flops, the logarithms not counted), σ = τ / J (9), and per active (k, l)
 //! the eigenbasis strain rate (9 × 7), its rotation Q Ĥ Qᵀ (2 × 54), D^alg : de (162) and the
@@ -27,11 +27,11 @@
 //! V, τ, the eigenvalues and eigenvectors of b^e, J: 8 (D² + 23) bytes) and its support (m
 //! node numbers and m D gradients: 8 m (1 + D)). Index scans, the equation lookups, the
 //! summing of a run's blocks and the transposes are not counted: the bound is a lower one.
-use igimp::load_stepping::LoadStepping;
-use igimp::method::Method;
+use igimp::basis::method::Method;
 use igimp::mpm::MpmSolver;
-use igimp::newton::NonlinearSystem;
 use igimp::problems::manufactured::{self, ManufacturedSpec};
+use igimp::solver::load_stepping::LoadStepping;
+use igimp::solver::newton::NonlinearSystem;
 use rayon::prelude::*;
 use std::hint::black_box;
 use std::time::Instant;

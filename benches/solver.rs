@@ -9,7 +9,7 @@
 //! - `assembly`: residual and tangent of a plane-strain Q4 mesh;
 //! - `factorisation`: numeric LU / LDLᵀ / LLᵀ + solve of that tangent;
 //! - `galerkin`: the multigrid's coarse operator Pᵀ (A P) of a plane 9-point, 2-component
-//!   matrix, by the crate's row-wise product ([`igimp::sparse::Csr::matmul`]) and by faer's
+//!   matrix, by the crate's row-wise product ([`igimp::solver::sparse::Csr::matmul`]) and by faer's
 //!   `sparse_sparse_matmul` (symbolic + numeric each time, as a new hierarchy needs; faer is
 //!   built without its rayon feature, so sequential: compare with `RAYON_NUM_THREADS=1`).
 //!
@@ -17,16 +17,16 @@
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use igimp::basis::{Basis, PointSupport, PointView, Support};
-use igimp::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
 use igimp::fem::{PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
-use igimp::grid::Grid;
-use igimp::kinematics::{evaluate_point, PointState};
-use igimp::linear::LinearSolver;
-use igimp::load_stepping::LoadStepping;
-use igimp::multigrid::{prolongation, DofGeometry};
-use igimp::newton::NonlinearSystem;
+use igimp::material::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
+use igimp::material::kinematics::{evaluate_point, PointState};
+use igimp::mesh::grid::Grid;
 use igimp::problems::column::ColumnSpec;
-use igimp::sparse::Csr;
+use igimp::solver::linear::LinearSolver;
+use igimp::solver::load_stepping::LoadStepping;
+use igimp::solver::multigrid::{prolongation, DofGeometry};
+use igimp::solver::newton::NonlinearSystem;
+use igimp::solver::sparse::Csr;
 use nalgebra::{Matrix3, SMatrix, SVector};
 use serde::Deserialize;
 use std::hint::black_box;

@@ -11,8 +11,8 @@
 //! count and the fitted rate; `tests/verification/families.rs` runs the same function.
 use igimp::basis::Basis;
 use igimp::basis::{AxisKernel, AxisWeights, BasisError, GimpKernel, GridAxis, TensorProduct};
-use igimp::load_stepping::LoadStepping;
 use igimp::problems::column::ColumnSpec;
+use igimp::solver::load_stepping::LoadStepping;
 use std::sync::Arc;
 
 /// The linear hat convolved with a box of half-width `fraction` × h.
@@ -53,11 +53,12 @@ pub fn column_errors(elements: &[usize]) -> (Vec<(usize, f64)>, f64) {
         let p = &solver.points;
         let sigma_exact: Vec<f64> = p.position0.iter().map(|x| exact.stress(x[0])).collect();
         let sigma: Vec<f64> = p.state.iter().map(|s| s.cauchy()[(0, 0)]).collect();
-        let e = igimp::norms::stress_error(&sigma_exact, &sigma, &p.volume0, spec.weight, spec.length);
+        let e =
+            igimp::problems::norms::stress_error(&sigma_exact, &sigma, &p.volume0, spec.weight, spec.length);
         out.push((n, e));
     }
     let (h, e): (Vec<f64>, Vec<f64>) = out.iter().map(|&(n, e)| (1.0 / n as f64, e)).unzip();
-    let slope = igimp::norms::fitted_rate(&h, &e).expect("two or more positive errors");
+    let slope = igimp::problems::norms::fitted_rate(&h, &e).expect("two or more positive errors");
     (out, slope)
 }
 

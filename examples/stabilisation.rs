@@ -4,7 +4,7 @@
 //!
 //! compaction: h ppc treatment [yield]   (treatment: none | tie | ghost:<gamma>[:all])
 //! cantilever: treatment [update]        (update: stretch | f-diagonal)
-use igimp::ghost::{GhostFaces, GhostSettings};
+use igimp::discretise::ghost::{GhostFaces, GhostSettings};
 use igimp::mpm::{DomainUpdate, WeakNodeTreatment};
 use igimp::problems::{cantilever, compaction};
 
@@ -42,7 +42,7 @@ fn main() {
                 weak_node_tolerance: tol,
                 weak_node_treatment: tr,
                 ghost,
-                linear_solver: igimp::linear::LinearSolver::Ldlt,
+                linear_solver: igimp::solver::linear::LinearSolver::Ldlt,
                 ..Default::default()
             };
             let o = compaction::solve_mpm(&spec).unwrap();

@@ -4,26 +4,31 @@
 //! Interpolation Material Point Method for large deformations* (the paper; equation numbers in
 //! the docs refer to it), with the verification studies that reproduce its results.
 //!
-//! ## Pipeline
-//! [`grid`] (regular background grid) → [`basis`] (MPM / GIMP weights, eqs 7–10) →
-//! [`assembly`] (per-point residual and tangent, eqs 27–29, 36, 41) with [`kinematics`]
-//! (ΔF, log strain, spatial tangent; eqs 15–19, 25, 30–36) and [`constitutive`] (eq 14) →
-//! [`linear`] (the solver strategy: a direct factorisation, or multigrid-preconditioned CG
-//! with GMRES and direct fallbacks) → [`newton`] (eqs 22–23) → [`mpm`] (load steps, commit,
-//! domain update eqs 37–39). The solver floors, each importing only those below it
-//! (`tests/verification/layering.rs`): [`sparse`] (CSC assembly storage, CSR products) →
-//! [`direct`] (faer LU, LDLᵀ, LLᵀ with cached symbolic analysis) and [`krylov`] (PCG,
-//! GMRES) → [`multigrid`] (the geometric V-cycle preconditioner) → [`linear`]. [`fem`] runs
-//! the same assembly, kinematics and Newton on Gauss points ([`quadrature`]) of
-//! updated-Lagrangian line (1D), Q4/Q8 (plane strain) and Hex8/Hex20 (3D) elements, the
-//! paper's comparators. [`problems`] holds the paper's
-//! examples with their analytical solutions; [`norms`] the error measures (eqs 46–47).
+//! ## Layers
+//! The library, each folder importing only those above it in this list
+//! (`tests/verification/layering.rs`):
+//! - [`solver`]: the algebra of a load step, knowing no grid, point or element — sparse
+//!   storage, faer's direct factorisations, PCG and GMRES, the geometric multigrid
+//!   preconditioner, the solver strategy ([`solver::linear`]), Newton (eqs 22–23), load
+//!   stepping and time integration (Newmark, generalised-α).
+//! - [`mesh`]: the background grid, Gauss rules, size estimates.
+//! - [`material`]: ΔF, log strain and the spatial tangent (eqs 15–19, 25, 30–36) and the
+//!   constitutive models (eq 14).
+//! - [`basis`]: the basis families (MPM, iGIMP eqs 7–10, CPDI2, B-splines, TLMPM) and the
+//!   method table ([`basis::method`]).
+//! - [`discretise`]: degrees of freedom, per-point residual and tangent assembly (eqs 27–29,
+//!   36, 41), ghost penalty.
+//! - [`mpm`]: the material points and their solver (load steps, commit, domain update eqs
+//!   37–39);
+//!   [`fem`]: the updated-Lagrangian line, Q4/Q8 and Hex8/Hex20 comparators on the same
+//!   assembly, kinematics and Newton.
+//! - [`problems`]: the paper's examples with their analytical solutions and the error
+//!   measures (eqs 46–47, [`problems::norms`]).
 //!
-//! Verification studies are data (`studies/*.toml`): `study` parses them and runs the
-//! cases (compute → `results.json`), `render` and `plot` render tables and SVG figures
-//! from that file alone. These modules, `kinds` and the `study` binary (the harness's front
-//! door: `cargo run --release --bin study -- column`) are the default feature `harness`;
-//! `default-features = false` builds the solver library alone.
+//! The harness (the default feature `harness`; `default-features = false` builds the
+//! library alone): `study` parses the study files (`studies/*.toml`) and runs their cases
+//! (compute → `results.json`), `study::render` draws tables and SVG figures from that file
+//! alone, and the `study` binary is its front door (`cargo run --release --bin study -- column`).
 //!
 //! ## Notation
 //! | paper | Rust |
@@ -76,61 +81,84 @@
 // obscure the index notation of the paper.
 #![allow(clippy::needless_range_loop)]
 
-pub mod assembly;
-pub mod atomic_file;
 pub mod basis;
-pub mod budget;
-pub mod constitutive;
-pub mod direct;
-pub mod dofs;
-pub mod dynamics;
-pub mod error;
+pub mod discretise;
 pub mod fem;
-pub mod ghost;
-pub mod grid;
-#[cfg(feature = "harness")]
-pub mod kinds;
-pub mod kinematics;
-pub mod krylov;
-pub mod linear;
-pub mod load_stepping;
-pub mod method;
+pub mod material;
+pub mod mesh;
 pub mod mpm;
-pub mod multigrid;
-pub mod newton;
-pub mod norms;
-pub mod particles;
-#[cfg(feature = "harness")]
-pub mod plot;
-#[cfg(feature = "harness")]
-pub mod plot2d;
 pub mod problems;
-pub mod profile;
-pub mod quadrature;
-#[cfg(feature = "harness")]
-pub mod render;
-#[cfg(feature = "seeded-bugs")]
-pub mod seeded;
-pub mod sparse;
+pub mod solver;
 #[cfg(feature = "harness")]
 pub mod study;
-pub mod tensor;
-pub mod vtk;
+
+#[cfg(feature = "seeded-bugs")]
+pub mod seeded {
+    //! Deliberately wrong kernels, compiled only with the `seeded-bugs` feature, so that the test
+    //! `tests/seeded.rs` can show each key check failing on a broken variant. The default build has
+    //! none of this: every call site is behind `#[cfg(feature = "seeded-bugs")]`.
+    //!
+    //! One process-wide switch (the solvers assemble on rayon threads, so a thread-local would not
+    //! reach them); the test that sets it runs its variants one after another in one test function.
+
+    use std::sync::atomic::{AtomicU8, Ordering};
+
+    /// A seeded bug.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    #[repr(u8)]
+    pub enum Bug {
+        /// The correct kernels.
+        None = 0,
+        /// The spatial tangent without its geometric term −σ_il δ_jk (eq 25).
+        NoGeometricTerm = 1,
+        /// Eq (36) without ΔF⁻¹: start-of-step gradients used as current ones.
+        NoDeltaFInverse = 2,
+        /// V_p = V_p^n instead of det(ΔF) V_p^n (eq 28).
+        NoVolumeChange = 3,
+        /// GIMP weights without the per-element split of eqs (7)–(10) (Figure 3): the whole
+        /// domain integrated against the shape functions of the element holding its centre.
+        NoElementSplit = 4,
+        /// Multigrid prolongation with the two weights along each axis swapped (t for the lower
+        /// node, 1 − t for the upper): a fine node on a coarse node draws on its neighbour.
+        SwappedProlongation = 5,
+        /// B-splines without their boundary treatment: the weights of nodes beyond the grid
+        /// dropped instead of folded back by linear extrapolation.
+        SplineWithoutBoundary = 6,
+        /// CPDI corners moved against the grid: x_α − Σ N_v(x_α) Δu_v.
+        CornersAgainstGrid = 7,
+        /// TLMPM with the reference gradients ∇₀S used as the start-of-step ones (no Fₙ⁻ᵀ).
+        ReferenceGradients = 8,
+        /// The effective tangent of a dynamic step without its mass term M/(βΔt²).
+        NoMassInTangent = 9,
+    }
+
+    static ACTIVE: AtomicU8 = AtomicU8::new(0);
+
+    /// Switch the kernels to `bug` (or back, with [`Bug::None`]).
+    pub fn set(bug: Bug) {
+        ACTIVE.store(bug as u8, Ordering::SeqCst);
+    }
+
+    /// Is `bug` the one switched on?
+    pub fn active(bug: Bug) -> bool {
+        ACTIVE.load(Ordering::Relaxed) == bug as u8
+    }
+}
 
 /// What a program that builds and runs a solver from its parts needs: the grid, the material
 /// points, the models, the solver and its settings, the load stepping, the errors, and the
 /// column's closed form for checking.
 pub mod prelude {
     pub use crate::basis::Basis;
-    pub use crate::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
-    pub use crate::error::{InputError, SolveError};
+    pub use crate::discretise::ghost::GhostSettings;
     pub use crate::fem::{HexElement, HexMesh, LineElement, LineMesh, PlaneMesh, QuadElement};
-    pub use crate::ghost::GhostSettings;
-    pub use crate::grid::Grid;
-    pub use crate::load_stepping::LoadStepping;
+    pub use crate::material::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
+    pub use crate::mesh::grid::Grid;
+    pub use crate::mpm::particles::MaterialPoints;
     pub use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
-    pub use crate::newton::NewtonSettings;
-    pub use crate::particles::MaterialPoints;
     pub use crate::problems::column::AnalyticalColumn;
+    pub use crate::solver::error::{InputError, SolveError};
+    pub use crate::solver::load_stepping::LoadStepping;
+    pub use crate::solver::newton::NewtonSettings;
     pub use nalgebra::SVector;
 }

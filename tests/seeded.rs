@@ -1,6 +1,6 @@
 //! Checks that prove they can fail: each key check runs on a deliberately wrong variant and
 //! must catch it, while passing on the correct kernels. The wrong kernels exist only with the
-//! `seeded-bugs` feature (`src/seeded.rs`): `cargo test --release --features seeded-bugs
+//! `seeded-bugs` feature (`src/lib.rs (seeded)`): `cargo test --release --features seeded-bugs
 //! --test seeded` (run by `.ci/run`). One test function, so the process-wide switch is never
 //! shared between concurrent tests.
 //!
@@ -17,10 +17,10 @@
 //! | TLMPM with ∇₀S as the start-of-step gradient (no Fₙ⁻ᵀ) | the column study's TLMPM rate bands |
 //! | dynamic tangent without its mass term M/(βΔt²) | Newton order on the vibrating bar (check_quadratic, order ≥ 1.8) |
 
-use igimp::method::Method;
-use igimp::newton::check_quadratic;
+use igimp::basis::method::Method;
 use igimp::problems::manufactured::{errors, solve, Exact, Field, ManufacturedSpec, PointValue};
 use igimp::seeded::{set, Bug};
+use igimp::solver::newton::check_quadratic;
 use igimp::study::engine::{run_in_memory, StudyKind};
 use igimp::study::manufactured::ManufacturedStudy;
 use igimp::study::Tier;
@@ -112,7 +112,7 @@ fn stress_rate(at_current: bool) -> f64 {
         h.push(1.0 / n as f64);
         e.push(errors(&exact, &pts).stress);
     }
-    igimp::norms::fitted_rate(&h, &e).unwrap()
+    igimp::problems::norms::fitted_rate(&h, &e).unwrap()
 }
 
 /// Largest difference between the GIMP weights of domains straddling an element edge and
@@ -152,9 +152,9 @@ fn gimp_weight_error() -> f64 {
 /// load step (the check of tests/verification/multigrid.rs: at most 20 per solve, none).
 fn multigrid_iterations() -> (f64, usize) {
     use igimp::fem::QuadElement;
-    use igimp::linear::LinearSolver;
-    use igimp::load_stepping::LoadStepping;
     use igimp::problems::compaction::{fem_solver, CompactionSpec};
+    use igimp::solver::linear::LinearSolver;
+    use igimp::solver::load_stepping::LoadStepping;
     let spec = CompactionSpec {
         element_size: 1.0 / 16.0,
         load_steps: 1,
@@ -174,7 +174,7 @@ fn multigrid_iterations() -> (f64, usize) {
 /// grid's lower edge (2D, unit cells).
 fn spline_unity_defect() -> f64 {
     use igimp::basis::{Basis, PointSupport, PointView};
-    use igimp::grid::Grid;
+    use igimp::mesh::grid::Grid;
     use nalgebra::{Matrix3, SVector};
     let grid = Grid::<2>::try_new([0.0; 2], [1.0; 2], [6; 2]).unwrap();
     let mut sup = PointSupport::<2>::default();
@@ -238,7 +238,7 @@ fn bar_newton_order() -> Result<usize, String> {
         elements: 16,
         steps_per_period: 32,
         periods: 0.5,
-        newton: igimp::newton::NewtonSettings {
+        newton: igimp::solver::newton::NewtonSettings {
             tolerance: 1e-11,
             max_iterations: 30,
             max_cutbacks: 0,

@@ -2,17 +2,17 @@
 //! part by part (weights, ghost faces, residual with the constitutive update, tangent
 //! assembly, factorisation + solve), the process's peak memory, and a driver that runs one
 //! child process per size so that each peak-memory figure is that size's alone.
-use igimp::assembly::{DofMap, LoadStepSystem};
-use igimp::ghost::{GhostFaces, GhostSettings};
-use igimp::linear::{LinearSolver, SparseSystem};
+use igimp::discretise::assembly::{DofMap, LoadStepSystem};
+use igimp::discretise::ghost::{GhostFaces, GhostSettings};
 use igimp::mpm::MpmSolver;
-use igimp::newton::NonlinearSystem;
+use igimp::solver::linear::{LinearSolver, SparseSystem};
+use igimp::solver::newton::NonlinearSystem;
 use std::time::Instant;
 
 /// The process's resident peak in MiB (NaN where /proc is unavailable), from the library's
 /// reader.
 pub fn peak_memory_mib() -> f64 {
-    igimp::profile::peak_resident_bytes().map_or(f64::NAN, |b| b as f64 / (1024.0 * 1024.0))
+    igimp::solver::profile::peak_resident_bytes().map_or(f64::NAN, |b| b as f64 / (1024.0 * 1024.0))
 }
 
 /// `SCALING_GHOST=<gamma>[:all]`: the ghost penalty (cut faces, or every face); default off.
@@ -97,8 +97,8 @@ pub fn time_iteration<const D: usize>(
     }
     matrix.set_pattern(columns);
     if solver == LinearSolver::Iterative {
-        let nodes = igimp::multigrid::NodeGeometry::of_grid(&solver_mpm.grid);
-        matrix.set_geometry(igimp::multigrid::DofGeometry::of_equations(&nodes, &dofs));
+        let nodes = igimp::solver::multigrid::NodeGeometry::of_grid(&solver_mpm.grid);
+        matrix.set_geometry(igimp::solver::multigrid::DofGeometry::of_equations(&nodes, &dofs));
         matrix.set_tolerance(1e-8);
     }
     let pattern = t.elapsed().as_secs_f64();

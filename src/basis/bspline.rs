@@ -80,7 +80,7 @@ impl AxisKernel for BsplineKernel {
     /// The spline's reach less one cell: h/2 (quadratic), h (cubic). A point reaches the nodes
     /// within 1.5h (2h) of it; the cell between such a node and the point has its near face
     /// within 0.5h (h) of the point, so the box overlaps a cell of every node the point reaches
-    /// and the ghost penalty (src/ghost.rs) sees every node the tangent holds. Counted in the
+    /// and the ghost penalty (src/discretise/ghost.rs) sees every node the tangent holds. Counted in the
     /// point's own cell only, a spline body's outer layer of nodes (weights of a few 1e-3 from
     /// points up to 1.5h or 2h away) sits in empty cells, carries no penalty, and the tangent
     /// turns singular there (measured in reference/README.md, item 39). The quadratic box is

@@ -15,7 +15,7 @@
 
 use super::linear::LinearKernel;
 use super::{AxisKernel, AxisWeights, BasisError, BasisFamily, GridAxis, PointSupport, PointView};
-use crate::grid::Grid;
+use crate::mesh::grid::Grid;
 use nalgebra::{SMatrix, SVector};
 
 /// CPDI2 with multilinear domains.

@@ -14,6 +14,7 @@ pub mod bspline;
 pub mod cpdi;
 pub mod gimp;
 pub mod linear;
+pub mod method;
 pub mod total_lagrangian;
 
 pub use bspline::{BsplineKernel, SplineBoundary, SplineDegree};
@@ -22,8 +23,8 @@ pub use gimp::{gimp_element_weights, GimpKernel};
 pub use linear::LinearKernel;
 pub use total_lagrangian::TotalLagrangian;
 
-use crate::grid::Grid;
-use crate::kinematics::stretch_tensor;
+use crate::material::kinematics::stretch_tensor;
+use crate::mesh::grid::Grid;
 use nalgebra::{Matrix3, SVector};
 use serde::{Deserialize, Serialize};
 

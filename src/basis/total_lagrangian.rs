@@ -9,7 +9,7 @@
 //! stress): the total-Lagrangian equations, with this code's consistent tangent.
 
 use super::{BasisError, BasisFamily, Configuration, PointSupport, PointView};
-use crate::grid::Grid;
+use crate::mesh::grid::Grid;
 use nalgebra::SVector;
 
 /// A basis evaluated in the reference configuration.

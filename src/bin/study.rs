@@ -5,9 +5,9 @@
 //! SVG figures and `reports/index.md` from those files.
 
 use clap::{CommandFactory, FromArgMatches, Parser};
-use igimp::kinds;
 use igimp::study::checks::{check_counts, CheckRecord};
 use igimp::study::engine::RunOptions;
+use igimp::study::kinds;
 use igimp::study::results::{read_json, CaseStatus, Failures};
 use igimp::study::store::Refusal;
 use igimp::study::vtk_output::VtkOptions;
@@ -20,7 +20,7 @@ use std::time::Instant;
 
 /// Counts each case's heap bytes for the `timing.costs` of `results.json`.
 #[global_allocator]
-static ALLOCATOR: igimp::profile::CountingAllocator = igimp::profile::CountingAllocator;
+static ALLOCATOR: igimp::solver::profile::CountingAllocator = igimp::solver::profile::CountingAllocator;
 
 #[derive(Debug, Parser)]
 #[command(

@@ -11,13 +11,13 @@ use super::quad::QuadElement;
 use super::updated_lagrangian::{
     fem_advance, fem_step_system, validate_stepping, FemMesh, GaussPoints, UlCore,
 };
-use crate::assembly::{LoadStepSystem, SupportTable};
-use crate::constitutive::ConstitutiveModel;
-use crate::dynamics::{BodyForce, Newmark};
-use crate::error::{require_finite, FailedAttempt, InputError, StepFailure};
-use crate::linear::LinearSolver;
-use crate::load_stepping::{Increment, LoadStepping};
-use crate::newton::NewtonSettings;
+use crate::discretise::assembly::{LoadStepSystem, SupportTable};
+use crate::material::constitutive::ConstitutiveModel;
+use crate::solver::dynamics::{BodyForce, Newmark};
+use crate::solver::error::{require_finite, FailedAttempt, InputError, StepFailure};
+use crate::solver::linear::LinearSolver;
+use crate::solver::load_stepping::{Increment, LoadStepping};
+use crate::solver::newton::NewtonSettings;
 use nalgebra::{Matrix3, SVector};
 use serde::{Deserialize, Serialize};
 
@@ -52,7 +52,7 @@ impl Default for PlaneFemSettings {
 impl PlaneFemSettings {
     pub fn validate(&self) -> Result<(), InputError> {
         if let Some(n) = self.gauss_points {
-            crate::quadrature::GaussRule::try_new(n)?;
+            crate::mesh::quadrature::GaussRule::try_new(n)?;
         }
         validate_stepping(&self.newton, self.load_steps)
     }
@@ -122,7 +122,7 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
         settings: PlaneFemSettings,
     ) -> Result<Self, InputError> {
         settings.validate()?;
-        crate::error::require_positive("density", density)?;
+        crate::solver::error::require_positive("density", density)?;
         for a in 0..D {
             require_finite(&format!("gravity[{a}]"), loads.gravity[a])?;
         }
@@ -147,7 +147,7 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
             }
             dof_forces.extend((0..D).map(|a| (D * n + a, f[a])));
         }
-        let points = crate::quadrature::tensor_rule::<D>(
+        let points = crate::mesh::quadrature::tensor_rule::<D>(
             settings
                 .gauss_points
                 .unwrap_or(mesh.element.default_gauss_points()),
@@ -179,7 +179,7 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
         self.core.model.as_ref()
     }
 
-    /// Make the analysis dynamic ([`crate::dynamics`]): the load steps become Newmark time
+    /// Make the analysis dynamic ([`crate::solver::dynamics`]): the load steps become Newmark time
     /// steps over `newmark.duration`, from the nodal velocities `velocity` and accelerations
     /// `acceleration` (one vector per node, `None`: zero; the fixed dofs' are taken as zero) at
     /// t = 0. The acceleration must balance the loads at t = 0 (M a₀ = f_ext(0) − f_int): a
@@ -191,7 +191,7 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
         acceleration: Option<&[SVector<f64, D>]>,
     ) -> Result<(), InputError> {
         newmark.validate()?;
-        if newmark.mass == crate::dynamics::MassMatrix::Lumped {
+        if newmark.mass == crate::solver::dynamics::MassMatrix::Lumped {
             self.check_lumped_masses()?;
         }
         let nn = self.mesh.num_nodes();
@@ -336,7 +336,7 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
     }
 
     /// What the linear solves have cost so far (solves, Krylov iterations, seconds).
-    pub fn linear_stats(&self) -> crate::linear::LinearStats {
+    pub fn linear_stats(&self) -> crate::solver::linear::LinearStats {
         self.core.work.matrix.stats()
     }
 
@@ -351,7 +351,7 @@ impl<const D: usize, E: ElementFamily<D>> LoadStepping for ContinuumFem<D, E> {
         // The multigrid coarsens the initial (structured) mesh: its nodes nest in the coarse
         // grids, which the deformed ones need not.
         if self.settings.linear_solver == LinearSolver::Iterative && self.core.work.node_geometry.is_none() {
-            self.core.work.node_geometry = Some(crate::multigrid::NodeGeometry::of_mesh(&self.mesh0));
+            self.core.work.node_geometry = Some(crate::solver::multigrid::NodeGeometry::of_mesh(&self.mesh0));
         }
         fem_advance(
             &mut self.core,

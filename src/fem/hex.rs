@@ -8,7 +8,7 @@
 //! [`super::mesh`], so a hexahedron is written to ParaView with its own node order.
 
 use super::mesh::{ElementFamily, ElementMesh};
-use crate::error::InputError;
+use crate::solver::error::InputError;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 

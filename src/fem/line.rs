@@ -1,8 +1,8 @@
 //! One-dimensional Lagrange line elements and meshes of them.
 
 use super::updated_lagrangian::FemMesh;
-use crate::assembly::SupportTable;
-use crate::error::{InputError, StepFailure};
+use crate::discretise::assembly::SupportTable;
+use crate::solver::error::{InputError, StepFailure};
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
@@ -82,7 +82,7 @@ impl LineMesh {
         upper: f64,
         elements: usize,
     ) -> Result<Self, InputError> {
-        crate::error::require_count("elements", elements, 1)?;
+        crate::solver::error::require_count("elements", elements, 1)?;
         if !(lower.is_finite() && upper.is_finite() && upper > lower) {
             return Err(InputError::new(
                 "mesh upper bound",

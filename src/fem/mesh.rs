@@ -7,8 +7,8 @@
 //! x(ξ) = Σ N_a(ξ) x_a, with J = ∂x/∂ξ = Σ x_a ⊗ ∂N_a/∂ξ (eq 34).
 
 use super::updated_lagrangian::FemMesh;
-use crate::assembly::SupportTable;
-use crate::error::{require_count, InputError, StepFailure};
+use crate::discretise::assembly::SupportTable;
+use crate::solver::error::{require_count, InputError, StepFailure};
 use nalgebra::{Matrix3, SMatrix, SVector};
 use std::fmt::Debug;
 
@@ -195,18 +195,18 @@ impl<const D: usize, E: ElementFamily<D>> ElementMesh<D, E> {
         const AXES: [&str; 3] = ["x", "y", "z"];
         for a in 0..D {
             require_count(&format!("mesh cells {}", AXES[a]), cells[a], 1)?;
-            crate::error::require_finite(&format!("mesh origin[{a}]"), origin[a])?;
-            crate::error::require_positive(&format!("mesh size[{a}]"), size[a])?;
+            crate::solver::error::require_finite(&format!("mesh origin[{a}]"), origin[a])?;
+            crate::solver::error::require_positive(&format!("mesh size[{a}]"), size[a])?;
         }
         let r = if element.quadratic() { 2 } else { 1 };
         // Checked in floating point before any product of counts can overflow or allocate:
         // the lattice's nodes (an upper bound of the mesh's) and Gauss points (r + 1 per axis).
         let cells_f: f64 = cells.iter().map(|&c| c as f64).product();
-        crate::budget::CaseSize {
+        crate::mesh::budget::CaseSize {
             dimension: D,
             nodes: cells.iter().map(|&c| r as f64 * c as f64 + 1.0).product(),
             points: cells_f * ((r + 1) as f64).powi(D as i32),
-            coupled_nodes: crate::budget::stencil(D, r),
+            coupled_nodes: crate::mesh::budget::stencil(D, r),
         }
         .check("mesh cells", format!("{cells:?}"))?;
         let m: [usize; D] = std::array::from_fn(|a| r * cells[a] + 1);
@@ -420,7 +420,7 @@ impl<const D: usize, E: ElementFamily<D>> FemMesh<D> for ElementMesh<D, E> {
 
 /// The multigrid's view of a mesh (its geometry adapter lives with the mesh, so the solver
 /// layers need not know the FEM types).
-impl crate::multigrid::NodeGeometry {
+impl crate::solver::multigrid::NodeGeometry {
     /// The nodes of an FEM mesh; the spacing is that of the first element's nodes (its
     /// extent per axis, halved for quadratic elements, whose mid-edge nodes halve it).
     pub fn of_mesh<const D: usize, E: ElementFamily<D>>(mesh: &ElementMesh<D, E>) -> Self {
@@ -436,9 +436,9 @@ impl crate::multigrid::NodeGeometry {
                 *h = (hi - lo) / if mesh.element.quadratic() { 2.0 } else { 1.0 };
             }
         }
-        crate::multigrid::NodeGeometry {
+        crate::solver::multigrid::NodeGeometry {
             dim: D,
-            positions: mesh.nodes.iter().map(crate::tensor::pad3).collect(),
+            positions: mesh.nodes.iter().map(crate::material::tensor::pad3).collect(),
             spacing,
         }
     }

@@ -14,9 +14,9 @@
 //! with the material point solver ([`crate::mpm::MpmSolver`]): Gauss points are integration
 //! points like material points, so each load step fills a [`SupportTable`] with the element
 //! shape functions N_a(ξ_q) and their gradients ∂N_a/∂X̃ on the start-of-step mesh
-//! (eqs 33–34), and the kinematics ([`crate::kinematics`], eqs 15–19, 25, 30–36), the
+//! (eqs 33–34), and the kinematics ([`crate::material::kinematics`], eqs 15–19, 25, 30–36), the
 //! constitutive update, the assembly ([`LoadStepSystem`], eqs 27, 29, 36), the sparse solve and
-//! Newton ([`crate::newton`]) are the same code.
+//! Newton ([`crate::solver::newton`]) are the same code.
 //!
 //! # Updated Lagrangian
 //! Nodes move with the material. At the start of a step the reference configuration X̃ is
@@ -63,13 +63,13 @@ pub use mesh::{serendipity_shape, ElementFamily, ElementMesh, Shape, MAX_ELEMENT
 pub use quad::{PlaneMesh, QuadElement, MAX_QUAD_NODES};
 pub use updated_lagrangian::{validate_stepping, FemMesh, GaussPoints, MAX_LOAD_STEPS};
 
-use crate::assembly::{LoadStepSystem, SupportTable};
-use crate::constitutive::ConstitutiveModel;
-use crate::dynamics::Newmark;
-use crate::error::{require_finite, FailedAttempt, InputError, StepFailure};
-use crate::load_stepping::{Increment, LoadStepping};
-use crate::newton::NewtonSettings;
-use crate::quadrature::GaussRule;
+use crate::discretise::assembly::{LoadStepSystem, SupportTable};
+use crate::material::constitutive::ConstitutiveModel;
+use crate::mesh::quadrature::GaussRule;
+use crate::solver::dynamics::Newmark;
+use crate::solver::error::{require_finite, FailedAttempt, InputError, StepFailure};
+use crate::solver::load_stepping::{Increment, LoadStepping};
+use crate::solver::newton::NewtonSettings;
 use nalgebra::SVector;
 use updated_lagrangian::{fem_advance, fem_step_system, UlCore};
 
@@ -125,7 +125,7 @@ impl LineFem {
         settings: LineFemSettings,
     ) -> Result<Self, InputError> {
         settings.validate()?;
-        crate::error::require_positive("density", density)?;
+        crate::solver::error::require_positive("density", density)?;
         require_finite("gravity", loads.gravity)?;
         for &n in &fixed {
             if n >= mesh.num_nodes() {
@@ -173,7 +173,7 @@ impl LineFem {
         &self.rule
     }
 
-    /// Make the analysis dynamic ([`crate::dynamics`]): the load steps become Newmark time
+    /// Make the analysis dynamic ([`crate::solver::dynamics`]): the load steps become Newmark time
     /// steps over `newmark.duration`, from the nodal velocities `velocity` (one per node; the
     /// fixed nodes' are taken as zero) and zero acceleration.
     pub fn set_dynamics(&mut self, newmark: Newmark, velocity: Vec<f64>) -> Result<(), InputError> {

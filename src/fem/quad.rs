@@ -5,7 +5,7 @@
 //! (0,−1), (1,0), (0,1), (−1,0). Shape functions and meshes are those of [`super::mesh`].
 
 use super::mesh::{ElementFamily, ElementMesh};
-use crate::error::InputError;
+use crate::solver::error::InputError;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
@@ -52,7 +52,7 @@ impl QuadElement {
     /// The tensor-product Gauss rule with `n` points per axis: points (ξ_i, η_j) and weights
     /// w_i w_j, ξ fastest.
     pub fn tensor_rule(n: usize) -> Result<Vec<(V2, f64)>, InputError> {
-        crate::quadrature::tensor_rule::<2>(n)
+        crate::mesh::quadrature::tensor_rule::<2>(n)
     }
 }
 

@@ -4,16 +4,16 @@
 //! positions). A solver adds only its shape functions: it fills the [`SupportTable`] with
 //! N_a(ξ_q) and ∂N_a/∂X̃ on the start-of-step mesh and moves its nodes by the increment.
 
-use crate::assembly::{LoadStepSystem, StartForces, StepInput, StepWorkspace, SupportTable};
-use crate::constitutive::ConstitutiveModel;
-use crate::dynamics::{BodyForce, Inertia, Newmark, TimeStep};
-use crate::error::{require_count, FailedAttempt, InputError, StepFailure};
-use crate::kinematics::PointState;
-use crate::load_stepping::Increment;
-use crate::newton::NewtonSettings;
+use crate::discretise::assembly::{LoadStepSystem, StartForces, StepInput, StepWorkspace, SupportTable};
+use crate::material::constitutive::ConstitutiveModel;
+use crate::material::kinematics::PointState;
+use crate::solver::dynamics::{BodyForce, Inertia, Newmark, TimeStep};
+use crate::solver::error::{require_count, FailedAttempt, InputError, StepFailure};
+use crate::solver::load_stepping::Increment;
+use crate::solver::newton::NewtonSettings;
 use nalgebra::SVector;
 
-pub use crate::load_stepping::MAX_LOAD_STEPS;
+pub use crate::solver::load_stepping::MAX_LOAD_STEPS;
 
 /// Check the Newton settings and the number of load steps (1..=[`MAX_LOAD_STEPS`]).
 pub fn validate_stepping(newton: &NewtonSettings, load_steps: usize) -> Result<(), InputError> {
@@ -104,7 +104,7 @@ pub(crate) struct UlCore<const D: usize> {
     pub fixed_dofs: Vec<(usize, usize)>,
     pub step: usize,
     pub work: StepWorkspace<D>,
-    /// Newmark time integration ([`crate::dynamics`]); `None`: quasi-static.
+    /// Newmark time integration ([`crate::solver::dynamics`]); `None`: quasi-static.
     pub dynamics: Option<Newmark>,
     pub motion: NodalState,
     /// A body force b₀(X, t) and the Gauss points' reference positions X_q and volumes V_q0 it
@@ -268,7 +268,7 @@ impl<const D: usize> UlCore<D> {
         loads: &FullLoads<'_, D>,
         build_supports: impl FnOnce(&mut SupportTable<D>) -> Result<(), StepFailure>,
     ) -> Result<Increment, FailedAttempt> {
-        crate::profile::timed(crate::profile::Phase::Weights, || {
+        crate::solver::profile::timed(crate::solver::profile::Phase::Weights, || {
             build_supports(&mut self.work.table)
         })
         .map_err(FailedAttempt::from)?;

@@ -6,25 +6,25 @@
 //! ```
 //!
 //! c = √(E/ρ) (ν = 0, so the uniaxial-strain modulus is E), period T = 4L/c. It is solved by
-//! Newmark time stepping ([`crate::dynamics`]) with the material point methods in 1D and the
+//! Newmark time stepping ([`crate::solver::dynamics`]) with the material point methods in 1D and the
 //! updated-Lagrangian line elements as comparators. The
 //! measures are the top point's displacement history, the period measured from its zero
 //! crossings, the total energy (kinetic + strain; no external work) and the displacement error
 //! at the end against the analytical field. At small v₀/c the finite-deformation solution is
 //! the linear one to O(v₀/c) (the strain amplitude).
 
+use crate::basis::method::Method;
 use crate::basis::DomainUpdate;
-use crate::constitutive::LinearElastic;
-use crate::dynamics::{LoadHistory, MassMatrix, Newmark};
-use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
-use crate::grid::Grid;
-use crate::kinematics::{log_strain, PointState};
-use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
-use crate::method::Method;
+use crate::material::constitutive::LinearElastic;
+use crate::material::kinematics::{log_strain, PointState};
+use crate::mesh::grid::Grid;
+use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
-use crate::newton::NewtonSettings;
-use crate::particles::MaterialPoints;
+use crate::solver::dynamics::{LoadHistory, MassMatrix, Newmark};
+use crate::solver::error::{require_count, require_positive, InputError, SolveError};
+use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
+use crate::solver::newton::NewtonSettings;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -49,7 +49,7 @@ pub struct BarSpec {
     pub mass: MassMatrix,
     pub newton: NewtonSettings,
     /// Generalised-α's spectral radius ρ∞ instead of `beta`, `gamma`
-    /// ([`crate::dynamics::GeneralizedAlpha`]); not serialised when absent (Newmark cases keep
+    /// ([`crate::solver::dynamics::GeneralizedAlpha`]); not serialised when absent (Newmark cases keep
     /// their keys).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rho_infinity: Option<f64>,
@@ -127,19 +127,19 @@ impl BarSpec {
         require_positive("bar.length", self.length)?;
         require_positive("bar.young_modulus", self.young_modulus)?;
         require_positive("bar.density", self.density)?;
-        crate::error::require_finite("bar.velocity", self.velocity)?;
+        crate::solver::error::require_finite("bar.velocity", self.velocity)?;
         require_count("bar.elements", self.elements, 1)?;
         require_count("bar.points_per_cell", self.points_per_cell, 1)?;
         require_count("bar.steps_per_period", self.steps_per_period, 1)?;
         require_positive("bar.periods", self.periods)?;
         // The closed form's scales, derived from L, E and ρ.
-        crate::load_stepping::require_time_scales(
+        crate::solver::load_stepping::require_time_scales(
             ("bar.periods", self.periods),
             self.steps_per_period,
             self.period(),
             ("bar.length", self.length, "(T = 4L/c)"),
         )?;
-        crate::error::require_finite("bar.velocity", self.velocity / self.omega())?;
+        crate::solver::error::require_finite("bar.velocity", self.velocity / self.omega())?;
         self.newmark().validate()
     }
 

@@ -15,21 +15,21 @@
 //! across the whole width (a line load); Hex8/Hex20 FEM carry it as the consistent line load on
 //! the end edge along the neutral axis.
 
+use crate::basis::method::Method;
 use crate::basis::Basis;
-use crate::constitutive::LinearElastic;
-use crate::error::{require_count, require_positive, InputError, SolveError};
+use crate::discretise::ghost::{GhostFaces, GhostSettings};
 use crate::fem::{
     ElementFamily, FemLoads, HexElement, HexMesh, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh,
     QuadElement, SolidFem,
 };
-use crate::ghost::{GhostFaces, GhostSettings};
-use crate::grid::Grid;
-use crate::linear::LinearSolver;
-use crate::load_stepping::{LoadStepping, StepReport};
-use crate::method::Method;
+use crate::material::constitutive::LinearElastic;
+use crate::mesh::grid::Grid;
+use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, VolumeUpdate, WeakNodeTreatment};
-use crate::newton::NewtonSettings;
-use crate::particles::MaterialPoints;
+use crate::solver::error::{require_count, require_positive, InputError, SolveError};
+use crate::solver::linear::LinearSolver;
+use crate::solver::load_stepping::{LoadStepping, StepReport};
+use crate::solver::newton::NewtonSettings;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
@@ -65,7 +65,7 @@ pub struct CantileverSpec {
     /// F-diagonal run completes although its domains shrink to a fraction of their size.
     #[serde(default)]
     pub volume_update: VolumeUpdate,
-    /// Ghost penalty of nearly empty cells ([`crate::ghost`]).
+    /// Ghost penalty of nearly empty cells ([`crate::discretise::ghost`]).
     #[serde(default)]
     pub ghost: GhostSettings,
     /// 2 (plane strain, the paper's) or 3 (a `depth × depth` section; see the module docs).
@@ -232,7 +232,7 @@ impl CantileverSpec {
         &self,
         basis: Basis,
         density: f64,
-        dynamics: Option<crate::dynamics::Newmark>,
+        dynamics: Option<crate::solver::dynamics::Newmark>,
     ) -> Result<(MpmSolver<2>, [usize; 2]), InputError> {
         self.validate()?;
         let h = self.element_size;

@@ -1,6 +1,6 @@
 //! The dynamic cantilever: the paper's beam (§5.3, [`crate::problems::cantilever`]) released
 //! from rest under its end load applied suddenly at t = 0⁺ and held, solved by Newmark time
-//! stepping ([`crate::dynamics`]) with every plane material point family and Q8 FEM.
+//! stepping ([`crate::solver::dynamics`]) with every plane material point family and Q8 FEM.
 //!
 //! There is no closed-form answer at finite rotation, so each analysis is measured against a
 //! reference analysis of the same beam (Q8 Newmark on a finer mesh and a finer Δt, a study's
@@ -17,14 +17,14 @@
 //! of the dead end load: the trapezoidal rule conserves it for a linear system and nearly so
 //! for this one.
 
-use crate::dynamics::{LoadHistory, MassMatrix, Newmark};
-use crate::error::{require_count, require_positive, InputError, SolveError};
+use crate::basis::method::Method;
 use crate::fem::{ElementFamily, PlaneFem};
-use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
-use crate::method::Method;
 use crate::mpm::MpmSolver;
 use crate::problems::bar::{period_of, strain_energy, total_energy};
 use crate::problems::cantilever::CantileverSpec;
+use crate::solver::dynamics::{LoadHistory, MassMatrix, Newmark};
+use crate::solver::error::{require_count, require_positive, InputError, SolveError};
+use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -48,7 +48,7 @@ pub struct DynamicCantileverSpec {
     pub beta: f64,
     pub gamma: f64,
     pub mass: MassMatrix,
-    /// Generalised-α's spectral radius ρ∞ ([`crate::dynamics::GeneralizedAlpha`]); `None`:
+    /// Generalised-α's spectral radius ρ∞ ([`crate::solver::dynamics::GeneralizedAlpha`]); `None`:
     /// Newmark with `beta`, `gamma`.
     pub rho_infinity: Option<f64>,
 }
@@ -72,7 +72,7 @@ impl DynamicCantileverSpec {
         require_positive("cantilever.periods", self.periods)?;
         require_count("cantilever.steps_per_period", self.steps_per_period, 1)?;
         // The time scales derived from the beam and ρ, before the Newmark settings see them.
-        crate::load_stepping::require_time_scales(
+        crate::solver::load_stepping::require_time_scales(
             ("cantilever.periods", self.periods),
             self.steps_per_period,
             self.period(),

@@ -5,19 +5,19 @@
 //! (uniaxial strain).
 
 use crate::basis::Basis;
-use crate::constitutive::{lame, ConstitutiveModel, LinearElastic};
-use crate::error::{require_count, require_derived, require_positive, InputError, SolveError};
+use crate::discretise::ghost::GhostSettings;
 use crate::fem::{
     HexElement, HexMesh, LineElement, LineFem, LineFemSettings, LineLoads, LineMesh, PlaneFemSettings,
     SolidFem, SolidLoads,
 };
-use crate::ghost::GhostSettings;
-use crate::grid::Grid;
-use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
+use crate::material::constitutive::{lame, ConstitutiveModel, LinearElastic};
+use crate::mesh::grid::Grid;
+use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
-use crate::newton::NewtonSettings;
-use crate::norms;
-use crate::particles::MaterialPoints;
+use crate::problems::norms;
+use crate::solver::error::{require_count, require_derived, require_positive, InputError, SolveError};
+use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
+use crate::solver::newton::NewtonSettings;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
@@ -250,7 +250,7 @@ pub fn f_from_cauchy_stress(s: f64) -> f64 {
     y.exp()
 }
 
-pub use crate::method::Method;
+pub use crate::basis::method::Method;
 
 /// The methods that solve the column.
 pub const METHODS: [Method; Method::FAMILIES + 2] = Method::listed(Some(1), &[]);
@@ -352,7 +352,7 @@ impl ColumnSpec {
         self.newton.validate()?;
         self.model()?;
         if let Some(n) = self.gauss_points {
-            crate::quadrature::GaussRule::try_new(n)?;
+            crate::mesh::quadrature::GaussRule::try_new(n)?;
         }
         // The load and the closed form's scales (eq 45): g, ρ0 g and M L0 / W.
         let (w, rho, l) = (self.weight, self.density, self.length);
@@ -398,7 +398,11 @@ impl ColumnSpec {
 
     /// The constitutive model: linear elastic, or von Mises when `yield_stress` is set.
     pub fn model(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
-        crate::constitutive::elastic_or_von_mises(self.young_modulus, self.poisson_ratio, self.yield_stress)
+        crate::material::constitutive::elastic_or_von_mises(
+            self.young_modulus,
+            self.poisson_ratio,
+            self.yield_stress,
+        )
     }
 
     /// Solver settings of the material point column (1D or 3D).

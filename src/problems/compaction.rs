@@ -7,21 +7,21 @@
 //! `weight` is the weight of the full block; the modelled half carries half of it, applied by
 //! gravity ramped over the load steps (ρ0 g = weight / (2 half_width · height), density 1).
 
+use crate::basis::method::Method;
 use crate::basis::Basis;
-use crate::constitutive::ConstitutiveModel;
-use crate::error::{require_count, require_positive, InputError, SolveError};
+use crate::discretise::ghost::{GhostFaces, GhostSettings};
 use crate::fem::{
     ContinuumFem, ElementFamily, ElementMesh, FemLoads, HexElement, HexMesh, PlaneFemSettings, PlaneMesh,
     QuadElement,
 };
-use crate::ghost::{GhostFaces, GhostSettings};
-use crate::grid::Grid;
-use crate::linear::LinearSolver;
-use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
-use crate::method::Method;
+use crate::material::constitutive::ConstitutiveModel;
+use crate::mesh::grid::Grid;
+use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver, WeakNodeTreatment};
-use crate::newton::NewtonSettings;
-use crate::particles::MaterialPoints;
+use crate::solver::error::{require_count, require_positive, InputError, SolveError};
+use crate::solver::linear::LinearSolver;
+use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
+use crate::solver::newton::NewtonSettings;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
@@ -56,7 +56,7 @@ pub struct CompactionSpec {
     /// Sparse factorisation; LDLᵀ suits this symmetric tangent (LU fallback).
     #[serde(default)]
     pub linear_solver: LinearSolver,
-    /// Ghost penalty of nearly empty cells ([`crate::ghost`]).
+    /// Ghost penalty of nearly empty cells ([`crate::discretise::ghost`]).
     #[serde(default)]
     pub ghost: GhostSettings,
     /// 2 (plane strain, the paper's) or 3: the quarter of a square block with two symmetry
@@ -153,7 +153,11 @@ impl CompactionSpec {
 
     /// Linear elastic, or von Mises when `yield_stress` is set.
     pub fn model(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
-        crate::constitutive::elastic_or_von_mises(self.young_modulus, self.poisson_ratio, self.yield_stress)
+        crate::material::constitutive::elastic_or_von_mises(
+            self.young_modulus,
+            self.poisson_ratio,
+            self.yield_stress,
+        )
     }
 
     /// ρ0 g of the block (density 1).

@@ -29,7 +29,7 @@
 //! - B. C. Carlson (1995), Numerical computation of real or complex elliptic integrals,
 //!   Numerical Algorithms 10, 13–26; DLMF §19.25, §19.36.
 
-use crate::error::{require_positive, InputError};
+use crate::solver::error::{require_positive, InputError};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, FRAC_PI_8};
 

@@ -19,17 +19,17 @@
 //! specified, would contradict the axis-aligned field (u_y = A sin πY ≠ 0 on X = 0);
 //! reference/README.md records the correction.
 
+use crate::basis::method::Method;
 use crate::basis::Basis;
-use crate::constitutive::{lame, LinearElastic};
-use crate::error::{require_count, require_positive, InputError, SolveError};
 use crate::fem::{ElementFamily, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
-use crate::grid::Grid;
-use crate::linear::LinearSolver;
-use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
-use crate::method::Method;
+use crate::material::constitutive::{lame, LinearElastic};
+use crate::mesh::grid::Grid;
+use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
-use crate::newton::NewtonSettings;
-use crate::particles::MaterialPoints;
+use crate::solver::error::{require_count, require_positive, InputError, SolveError};
+use crate::solver::linear::LinearSolver;
+use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
+use crate::solver::newton::NewtonSettings;
 use nalgebra::{Matrix3, SVector};
 use num_dual::{Dual64, DualNum};
 use serde::{Deserialize, Serialize};

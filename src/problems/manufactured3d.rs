@@ -16,15 +16,15 @@ use super::manufactured::{
     deformation_gradient, first_piola_block, kirchhoff_block, motion, mpm_settings, rollers, Errors, Field,
     ManufacturedSpec, M2,
 };
-use crate::constitutive::{lame, LinearElastic};
-use crate::error::{InputError, SolveError};
+use crate::basis::method::Method;
 use crate::fem::{ElementFamily, FemLoads, HexElement, HexMesh, PlaneFemSettings, SolidFem};
-use crate::grid::Grid;
-use crate::linear::LinearSolver;
-use crate::load_stepping::{steps_and_failure, LoadStepping, StepReport};
-use crate::method::Method;
+use crate::material::constitutive::{lame, LinearElastic};
+use crate::mesh::grid::Grid;
+use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{Loads, MpmSolver};
-use crate::particles::MaterialPoints;
+use crate::solver::error::{InputError, SolveError};
+use crate::solver::linear::LinearSolver;
+use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
 use nalgebra::{Matrix3, SVector};
 use num_dual::{Dual64, DualNum};
 use serde::{Deserialize, Serialize};
@@ -282,7 +282,7 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
             // The consistent nodal force of the dead load: Σ_g N_a(ξ_g) b₀(X_g) w_g det J₀.
             let mut force = vec![V3::zeros(); mesh.num_nodes()];
             for e in 0..mesh.num_elements() {
-                for (xi, w) in crate::quadrature::tensor_rule::<3>(element.default_gauss_points())? {
+                for (xi, w) in crate::mesh::quadrature::tensor_rule::<3>(element.default_gauss_points())? {
                     let (x0, jac) = mesh.map(e, &xi);
                     let b = V3::from(exact.body_force([x0[0], x0[1], x0[2]]));
                     let (shape, _) = element.shape(&xi);

@@ -18,28 +18,28 @@
 //! at time t is the static field's at amplitude a(t) (forward-mode automatic differentiation).
 //! The analysis starts from x = X with the exact velocity and acceleration (M a₀ balances
 //! f_ext(0): a wrong a₀ would cost the trapezoidal rule its order) and runs Newmark time steps
-//! ([`crate::dynamics`]) to `periods` × T, T = 2π/ω. The errors are the static study's
+//! ([`crate::solver::dynamics`]) to `periods` × T, T = 2π/ω. The errors are the static study's
 //! (displacement and stress at the points) at the end, against the motion at that time.
 
 use super::manufactured::{
     errors, fem_point_values, mpm_point_values, mpm_settings, rollers, Exact, Field, ManufacturedSolution,
 };
 use super::manufactured3d::{errors_3d, point_values_3d, Exact3, Solution3, METHODS_3D};
+use crate::basis::method::Method;
 use crate::basis::DomainUpdate;
-use crate::constitutive::{lame, LinearElastic};
-use crate::dynamics::{BodyForce, LoadHistory, MassMatrix, Newmark};
-use crate::error::{require_count, require_positive, InputError};
 use crate::fem::{
     ContinuumFem, ElementFamily, ElementMesh, FemLoads, HexElement, HexMesh, PlaneFemSettings, PlaneMesh,
     QuadElement,
 };
-use crate::grid::Grid;
-use crate::linear::LinearSolver;
-use crate::load_stepping::{steps_and_failure, LoadStepping};
-use crate::method::Method;
+use crate::material::constitutive::{lame, LinearElastic};
+use crate::mesh::grid::Grid;
+use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
-use crate::newton::NewtonSettings;
-use crate::particles::MaterialPoints;
+use crate::solver::dynamics::{BodyForce, LoadHistory, MassMatrix, Newmark};
+use crate::solver::error::{require_count, require_positive, InputError};
+use crate::solver::linear::LinearSolver;
+use crate::solver::load_stepping::{steps_and_failure, LoadStepping};
+use crate::solver::newton::NewtonSettings;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -72,7 +72,7 @@ pub struct DynamicManufacturedSpec {
     pub mass: MassMatrix,
     pub newton: NewtonSettings,
     /// Generalised-α's spectral radius ρ∞ instead of `beta`, `gamma`
-    /// ([`crate::dynamics::GeneralizedAlpha`]); not serialised when absent (Newmark cases keep
+    /// ([`crate::solver::dynamics::GeneralizedAlpha`]); not serialised when absent (Newmark cases keep
     /// their keys).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rho_infinity: Option<f64>,
@@ -136,9 +136,9 @@ impl DynamicManufacturedSpec {
         require_count("steps_per_period", self.steps_per_period, 1)?;
         require_positive("periods", self.periods)?;
         // The step count first: the static spec's checks read it as `load_steps`.
-        crate::load_stepping::require_time_steps("periods", self.periods, self.steps_per_period)?;
+        crate::solver::load_stepping::require_time_steps("periods", self.periods, self.steps_per_period)?;
         self.static_spec().validate()?;
-        crate::load_stepping::require_time_scales(
+        crate::solver::load_stepping::require_time_scales(
             ("periods", self.periods),
             self.steps_per_period,
             self.period(),

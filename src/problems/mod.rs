@@ -10,3 +10,4 @@ pub mod elastica;
 pub mod manufactured;
 pub mod manufactured3d;
 pub mod manufactured_dynamic;
+pub mod norms;

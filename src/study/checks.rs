@@ -72,13 +72,13 @@ pub fn check_counts(checks: &[CheckRecord]) -> (usize, usize, usize) {
     n
 }
 
-/// Least-squares slope of log(error) against log(h) ([`crate::norms::fitted_rate`]) over
+/// Least-squares slope of log(error) against log(h) ([`crate::problems::norms::fitted_rate`]) over
 /// the last `finest` of the (h, error) pairs given coarse to fine; `None` with fewer than two
 /// pairs. Returns the slope and how many pairs it used.
 pub fn fitted_rate_finest(h: &[f64], error: &[f64], finest: Option<usize>) -> (Option<f64>, usize) {
     let n = finest.map_or(h.len(), |n| n.min(h.len()));
     let (h, e) = (&h[h.len() - n..], &error[error.len() - n..]);
-    (crate::norms::fitted_rate(h, e), n)
+    (crate::problems::norms::fitted_rate(h, e), n)
 }
 
 /// (max − min)/|min| of at least two values, the spread of a sensitivity check.

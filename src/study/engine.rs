@@ -16,8 +16,8 @@ use super::results::{
 use super::store::{CaseStore, Refusal};
 use super::vtk_output::{pvd_path, VtkOptions};
 use super::{Distribution, StudyError, Tier};
-use crate::method::Method;
-use crate::profile::{self, CaseCost};
+use crate::basis::method::Method;
+use crate::solver::profile::{self, CaseCost};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

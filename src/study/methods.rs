@@ -1,6 +1,6 @@
 //! The cross-method comparison: every method's fitted rates, deviations and GCI
 //! extrapolations, gathered from the `results.json` of the studies in one output folder into
-//! `<out>/methods/methods.json`, which `crate::render::methods` alone draws from.
+//! `<out>/methods/methods.json`, which `crate::study::render::methods` alone draws from.
 //!
 //! Nothing is solved here. The column-type, manufactured and dynamics studies contribute their
 //! fitted rates (the `rates` array; a dynamics study's name the method inside `series` and say
@@ -11,7 +11,7 @@
 //! that must agree for two methods to share axes (load, points per cell, field, domain
 //! update).
 
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::study::results::Software;
 use crate::study::vocabulary::number;
 use serde::{Deserialize, Serialize};

@@ -5,27 +5,31 @@
 //! Pipeline (compute → JSON → render): [`engine::run`] solves every case of any
 //! [`engine::StudyKind`] (rayon, results in a fixed order, the case store, `--resume`,
 //! `--vtk`, `--shard`/`--merge`) and [`engine::write_outputs`] writes the [`results::Envelope`]
-//! as `results.json`; [`crate::render`] reads only the results files. The kinds: [`column`](mod@column)
+//! as `results.json`; [`crate::study::render`] reads only the results files. The kinds: [`column`](mod@column)
 //! (§5.1), [`compaction`] (§5.2), [`cantilever`] (§5.3), [`manufactured`] and the
-//! [`dynamics`] (the vibrating bar and the dynamic manufactured fields); [`crate::kinds`]
+//! [`dynamics`] (the vibrating bar and the dynamic manufactured fields); [`crate::study::kinds`]
 //! registers them.
 //!
 //! Counts in the files are parsed as signed integers so that a negative value is reported by
 //! validation with its key and allowed range instead of as a type error.
 
+pub mod atomic_file;
 pub mod cantilever;
 pub mod checks;
 pub mod column;
 pub mod compaction;
 pub mod dynamics;
 pub mod engine;
+pub mod kinds;
 pub mod locate;
 pub mod manufactured;
 pub mod methods;
+pub mod render;
 pub mod replace;
 pub mod results;
 pub mod store;
 pub mod vocabulary;
+pub mod vtk;
 pub mod vtk_output;
 
 use serde::{Deserialize, Serialize};

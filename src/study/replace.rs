@@ -12,7 +12,7 @@
 //! The moves run under a lock file so that two processes never interleave them.
 
 use super::StudyError;
-use crate::atomic_file::{host_tag, is_stale_temp};
+use crate::study::atomic_file::{host_tag, is_stale_temp};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -226,7 +226,7 @@ fn lock_abandoned(path: &Path) -> bool {
             .and_then(|m| m.modified())
             .ok()
             .and_then(|t| t.elapsed().ok())
-            .is_some_and(|a| a > crate::atomic_file::STALE_TEMP_AGE);
+            .is_some_and(|a| a > crate::study::atomic_file::STALE_TEMP_AGE);
     };
     host == host_tag() && Path::new("/proc/self").exists() && !Path::new("/proc").join(pid).exists()
 }

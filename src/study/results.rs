@@ -8,9 +8,9 @@
 
 use super::checks::{check_counts, CheckRecord};
 use super::{StudyError, Tier};
-use crate::error::SolveError;
-use crate::load_stepping::StepReport;
-use crate::profile::CaseCost;
+use crate::solver::error::SolveError;
+use crate::solver::load_stepping::StepReport;
+use crate::solver::profile::CaseCost;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -58,7 +58,7 @@ pub struct StepRecord {
     #[serde(default, skip_serializing_if = "is_zero")]
     pub linear_iterations: usize,
     /// Accepted stalled at this estimated round-off floor, above the tolerance but within
-    /// [`crate::newton::FLOOR_ACCEPT_FACTOR`] of it (absent: the tolerance was met).
+    /// [`crate::solver::newton::FLOOR_ACCEPT_FACTOR`] of it (absent: the tolerance was met).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub accepted_at_floor: Option<f64>,
 }

@@ -20,7 +20,7 @@
 //! The store is generic over the record type; [`super::engine`] uses it for every kind.
 
 use super::StudyError;
-pub use crate::atomic_file::write_atomic;
+pub use crate::study::atomic_file::write_atomic;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::{Component, Path, PathBuf};
@@ -204,10 +204,10 @@ pub struct CaseStore {
 impl CaseStore {
     /// The store in `dir` (created if missing); temporary files abandoned by a killed run
     /// are removed, those of another live writer (a concurrent shard) are not
-    /// ([`crate::atomic_file::is_stale_temp`]).
+    /// ([`crate::study::atomic_file::is_stale_temp`]).
     pub fn open(dir: &Path) -> Result<Self, StudyError> {
         std::fs::create_dir_all(dir).map_err(|e| StudyError::io(dir, e))?;
-        crate::atomic_file::remove_stale_temps(dir).map_err(|e| StudyError::io(dir, e))?;
+        crate::study::atomic_file::remove_stale_temps(dir).map_err(|e| StudyError::io(dir, e))?;
         Ok(Self {
             dir: dir.to_path_buf(),
         })

@@ -4,10 +4,10 @@
 
 use super::{StudyError, SCHEMA_VERSION};
 /// Settings the study files (and so `results.json`) hold, for the renderers to read.
-pub use crate::ghost::{GhostFaces, GhostSettings};
+pub use crate::discretise::ghost::{GhostFaces, GhostSettings};
 pub use crate::mpm::WeakNodeTreatment;
-use crate::newton::NewtonSettings;
-pub use crate::newton::ResidualNorm;
+use crate::solver::newton::NewtonSettings;
+pub use crate::solver::newton::ResidualNorm;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
@@ -27,7 +27,7 @@ pub struct NewtonSection {
     /// over all dofs, exact reactions) or `linearised` (the paper's Tables 2–3: reactions
     /// updated by their linearised increment, their out-of-balance in the numerator).
     #[serde(default)]
-    pub residual_norm: crate::newton::ResidualNorm,
+    pub residual_norm: crate::solver::newton::ResidualNorm,
     /// Adaptive load stepping: most halvings of a failing increment (0..=20, default 6:
     /// down to 1/64 of a load step; 0 = fixed steps).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -41,7 +41,9 @@ impl NewtonSection {
             max_iterations: self.max_iterations as usize,
             line_search: self.line_search,
             residual_norm: self.residual_norm,
-            max_cutbacks: self.max_cutbacks.unwrap_or(crate::newton::DEFAULT_CUTBACKS),
+            max_cutbacks: self
+                .max_cutbacks
+                .unwrap_or(crate::solver::newton::DEFAULT_CUTBACKS),
         }
     }
 }
@@ -56,7 +58,7 @@ pub struct WeakNodeSection {
     pub treatment: WeakNodeTreatment,
 }
 
-/// Ghost stabilisation as written in a study file ([`crate::ghost`]): γ and the faces for
+/// Ghost stabilisation as written in a study file ([`crate::discretise::ghost`]): γ and the faces for
 /// two or more points per cell, the settings for one point per cell (every face), and those
 /// of plastic cases.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -65,22 +67,22 @@ pub struct GhostSection {
     /// Penalty factor γ for two or more points per cell (0 = off); in [0, 1000].
     pub gamma: f64,
     #[serde(default)]
-    pub faces: crate::ghost::GhostFaces,
+    pub faces: crate::discretise::ghost::GhostFaces,
     /// Fill fraction below which a cell is cut, in (0, 1]; default
-    /// [`crate::ghost::DEFAULT_CUT_FILL`].
+    /// [`crate::discretise::ghost::DEFAULT_CUT_FILL`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cut_fill: Option<f64>,
-    /// Node share below which a node's cells are cut too ([`crate::ghost::GhostSettings::cut_share`]);
+    /// Node share below which a node's cells are cut too ([`crate::discretise::ghost::GhostSettings::cut_share`]);
     /// default 0 (off).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cut_share: Option<f64>,
     /// Settings for one point per cell; default: the ones above.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub one_point_per_cell: Option<crate::ghost::GhostSettings>,
+    pub one_point_per_cell: Option<crate::discretise::ghost::GhostSettings>,
     /// Settings for plastic (von Mises) cases with two or more points per cell; default: the
     /// ones above.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub plastic: Option<crate::ghost::GhostSettings>,
+    pub plastic: Option<crate::discretise::ghost::GhostSettings>,
     /// Where the defaults come from (the measurement that chose them).
     pub source: String,
 }
@@ -88,14 +90,21 @@ pub struct GhostSection {
 impl GhostSection {
     /// The settings of a case with `ppc` points per cell, plastic or not; `gamma` (a sweep's
     /// value) replaces the default γ.
-    pub fn settings(&self, ppc: usize, plastic: bool, gamma: Option<f64>) -> crate::ghost::GhostSettings {
+    pub fn settings(
+        &self,
+        ppc: usize,
+        plastic: bool,
+        gamma: Option<f64>,
+    ) -> crate::discretise::ghost::GhostSettings {
         let mut g = match (ppc, self.one_point_per_cell, plastic, self.plastic) {
             (1, Some(one), _, _) => one,
             (_, _, true, Some(p)) => p,
-            _ => crate::ghost::GhostSettings {
+            _ => crate::discretise::ghost::GhostSettings {
                 gamma: self.gamma,
                 faces: self.faces,
-                cut_fill: self.cut_fill.unwrap_or(crate::ghost::DEFAULT_CUT_FILL),
+                cut_fill: self
+                    .cut_fill
+                    .unwrap_or(crate::discretise::ghost::DEFAULT_CUT_FILL),
                 cut_share: self.cut_share.unwrap_or(0.0),
             },
         };
@@ -105,7 +114,7 @@ impl GhostSection {
         g
     }
 
-    pub fn validate(&self) -> Result<(), crate::error::InputError> {
+    pub fn validate(&self) -> Result<(), crate::solver::error::InputError> {
         self.settings(2, false, None).validate()?;
         self.settings(2, true, None).validate()?;
         self.settings(1, false, None).validate()
@@ -159,7 +168,7 @@ pub fn short(v: f64) -> String {
 /// without a trailing `.0` (`40000`, `0.25`, `1e300`, `1e-300`): Rust's `Display` writes
 /// every digit of 1e300, which made a 301-character file name of a case id.
 pub fn number(x: f64) -> String {
-    crate::error::shortest(x)
+    crate::solver::error::shortest(x)
 }
 
 /// Validation of one study file: every error names the file, the key, the value and the
@@ -179,7 +188,7 @@ impl Checker<'_> {
     }
     /// Case `case` of the section `scope` (`sweeps[0]`, `cases[2]`) is an invalid problem
     /// input `e`, whose field the problem names ([`super::locate`] finds the file's key).
-    pub fn case_input(&self, scope: &str, case: &str, e: crate::error::InputError) -> StudyError {
+    pub fn case_input(&self, scope: &str, case: &str, e: crate::solver::error::InputError) -> StudyError {
         StudyError::CaseInput(Box::new(super::CaseInput {
             file: self.file.to_string(),
             scope: scope.to_string(),
@@ -268,7 +277,7 @@ impl Checker<'_> {
         self.markdown_file("report_file", h.report_file)
     }
     pub fn newton(&self, key: &str, n: &NewtonSection) -> Result<(), StudyError> {
-        let min = crate::newton::MIN_TOLERANCE;
+        let min = crate::solver::newton::MIN_TOLERANCE;
         if !(n.tolerance.is_finite() && (min..1.0).contains(&n.tolerance)) {
             return Err(self.err(
                 format!("{key}.tolerance"),
@@ -278,7 +287,7 @@ impl Checker<'_> {
         }
         self.count(&format!("{key}.max_iterations"), n.max_iterations, 1, 1000)?;
         if let Some(m) = n.max_cutbacks {
-            let max = crate::newton::MAX_CUTBACKS;
+            let max = crate::solver::newton::MAX_CUTBACKS;
             if m > max {
                 return Err(self.err(
                     format!("{key}.max_cutbacks"),
@@ -323,8 +332,8 @@ pub fn invalid(
     StudyError::Invalid {
         file: file.to_string(),
         key: key.into(),
-        value: crate::error::tidy_numbers(&value.to_string()),
-        allowed: crate::error::tidy_numbers(&allowed.into()),
+        value: crate::solver::error::tidy_numbers(&value.to_string()),
+        allowed: crate::solver::error::tidy_numbers(&allowed.into()),
     }
 }
 

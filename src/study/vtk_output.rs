@@ -5,7 +5,7 @@
 //! Layout inside the study folder: `vtk/<case-id>.pvd` (a collection with time = load factor,
 //! part 0 the material or Gauss points, part 1 the background grid or FEM mesh) and
 //! `vtk/<case-id>/{points,grid}_<step>.vtu` for step 0 (initial state), every `every`-th load
-//! step and the last converged step. The point arrays are those of [`crate::vtk`]; the MPM
+//! step and the last converged step. The point arrays are those of [`crate::study::vtk`]; the MPM
 //! grid carries `displacement_increment` (Δu of the step) and `displacement` (Σ Δu over the
 //! steps at the fixed node; the grid itself never moves), the FEM mesh its nodal
 //! `displacement`.
@@ -14,7 +14,7 @@ use super::store::confined;
 use super::StudyError;
 use crate::fem::{ElementFamily, HexElement};
 use crate::problems::column::ColumnState;
-use crate::vtk::{self, pad3, PvdEntry, UnstructuredGrid};
+use crate::study::vtk::{self, pad3, PvdEntry, UnstructuredGrid};
 use std::path::{Path, PathBuf};
 
 /// Which load steps to write.
@@ -268,8 +268,8 @@ pub fn domains_grid(frame: &DomainFrame) -> UnstructuredGrid {
 /// alone).
 pub fn grid_part<E>(
     dimension: usize,
-    plane: impl FnOnce() -> Result<crate::grid::Grid<2>, E>,
-    solid: impl FnOnce() -> Result<crate::grid::Grid<3>, E>,
+    plane: impl FnOnce() -> Result<crate::mesh::grid::Grid<2>, E>,
+    solid: impl FnOnce() -> Result<crate::mesh::grid::Grid<3>, E>,
 ) -> Option<UnstructuredGrid> {
     if dimension == 3 {
         solid().ok().map(|g| vtk::background_grid(&g, &[]))

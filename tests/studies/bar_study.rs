@@ -3,9 +3,9 @@
 //! second order in h, the period within 0.5 %, the energy bounded), the outputs re-render byte
 //! for byte, and the time-rate band fails for a damped Newmark (γ = 0.6: first order).
 
-use igimp::render::dynamics::render;
 use igimp::study::dynamics::DynamicStudy;
 use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
+use igimp::study::render::dynamics::render;
 use igimp::study::Tier;
 use std::path::Path;
 use std::sync::OnceLock;

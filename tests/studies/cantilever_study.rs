@@ -5,9 +5,9 @@
 //!
 //! Everything is written to temporary folders, never to the repository's `reports/`.
 
-use igimp::render::cantilever::render;
 use igimp::study::cantilever::{CantileverResults, CantileverStudy};
 use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
+use igimp::study::render::cantilever::render;
 use igimp::study::results::CaseStatus;
 use igimp::study::Tier;
 

@@ -61,7 +61,7 @@ fn column_3d_equals_the_1d_column() {
     // Newton converges quadratically in 3D, as in 1D.
     for c in &d3.cases {
         for s in &c.solve.steps {
-            igimp::newton::check_quadratic(&s.residuals, 1e-3, 1e-11, 1.0, 1.8)
+            igimp::solver::newton::check_quadratic(&s.residuals, 1e-3, 1e-11, 1.0, 1.8)
                 .unwrap_or_else(|e| panic!("{} step {}: {e}", c.id, s.step));
         }
     }
@@ -70,7 +70,7 @@ fn column_3d_equals_the_1d_column() {
 /// A dimension other than 1 or 3, and FEM in 3D, are input errors naming the field.
 #[test]
 fn column_dimension_is_validated() {
-    use igimp::method::Method;
+    use igimp::basis::method::Method;
     use igimp::problems::column::{solve_column, ColumnSpec};
     let e = ColumnSpec {
         dimension: 2,

@@ -5,9 +5,9 @@
 //! file is evaluated and met.
 
 use igimp::fem::QuadElement;
-use igimp::linear::LinearSolver;
-use igimp::newton::check_quadratic;
 use igimp::problems::compaction::{solve_fem, CompactionSpec};
+use igimp::solver::linear::LinearSolver;
+use igimp::solver::newton::check_quadratic;
 use igimp::study::checks::richardson;
 use igimp::study::compaction::CompactionStudy;
 use igimp::study::engine::{run_in_memory, StudyKind};

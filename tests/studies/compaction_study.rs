@@ -4,9 +4,9 @@
 //!
 //! Everything is written to temporary folders, never to the repository's `reports/`.
 
-use igimp::render::compaction::render;
 use igimp::study::compaction::{CompactionResults, CompactionStudy};
 use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
+use igimp::study::render::compaction::render;
 use igimp::study::results::CaseStatus;
 use igimp::study::Tier;
 

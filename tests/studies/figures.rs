@@ -4,8 +4,8 @@
 //! for SVG and Markdown. Plus one test per figure defect, on synthetic data through the
 //! public plotting functions.
 
-use igimp::plot::{convergence_svg_along, profile_svg, ConvergenceSeries, ProfileSeries};
-use igimp::plot2d::{xy_svg, LegendCorner, XyAxes, XySeries};
+use igimp::study::render::plot::{convergence_svg_along, profile_svg, ConvergenceSeries, ProfileSeries};
+use igimp::study::render::plot2d::{xy_svg, LegendCorner, XyAxes, XySeries};
 use std::path::{Path, PathBuf};
 
 fn reports() -> PathBuf {
@@ -43,7 +43,7 @@ struct Label {
 
 impl Label {
     /// Its extent (x0, y0, x1, y1) in canvas pixels, estimated as the renderer lays text out:
-    /// 0.6 em per character (src/plot/layout.rs), one em high.
+    /// 0.6 em per character (src/study/render/plot/layout.rs), one em high.
     fn extent(&self) -> (f64, f64, f64, f64) {
         let w = 0.6 * self.size * self.text.chars().count() as f64;
         let (a, b) = match self.anchor.as_str() {
@@ -226,8 +226,8 @@ fn study_text_is_escaped_for_svg_and_markdown() {
         f["title"] = format!("a\u{7}b <i>&</i> [x](y) | c\n## d {t}").into();
     }
     std::fs::write(dir.join("results.json"), serde_json::to_string(&v).unwrap()).unwrap();
-    let rendered = igimp::kinds::render_dir(&dir).unwrap();
-    let index = igimp::kinds::render_index(tmp.path()).unwrap();
+    let rendered = igimp::study::kinds::render_dir(&dir).unwrap();
+    let index = igimp::study::kinds::render_index(tmp.path()).unwrap();
     let svgs: Vec<&PathBuf> = rendered
         .files
         .iter()

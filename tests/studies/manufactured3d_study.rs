@@ -5,9 +5,9 @@
 //! byte.
 
 use igimp::problems::manufactured3d::Exact3;
-use igimp::render::manufactured::render;
 use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
 use igimp::study::manufactured::ManufacturedStudy;
+use igimp::study::render::manufactured::render;
 use igimp::study::results::CaseStatus;
 use igimp::study::Tier;
 use std::path::Path;

@@ -5,12 +5,12 @@
 //!
 //! Everything is written to temporary folders, never to the repository's `reports/`.
 
-use igimp::method::Method;
+use igimp::basis::method::Method;
 use igimp::mpm::DomainUpdate;
 use igimp::problems::manufactured::motion;
-use igimp::render::manufactured::render;
 use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
 use igimp::study::manufactured::{Field, ManufacturedStudy};
+use igimp::study::render::manufactured::render;
 use igimp::study::results::CaseStatus;
 use igimp::study::Tier;
 use std::path::Path;

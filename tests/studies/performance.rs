@@ -4,7 +4,7 @@
 //! present and consistent. The compaction's quick tier, run by the `study` binary (whose
 //! allocator counts the heap).
 
-use igimp::method::Method;
+use igimp::basis::method::Method;
 use igimp::study::compaction::CompactionResults;
 use igimp::study::results::{read_results, CaseStatus};
 use std::process::Command;

@@ -2,7 +2,7 @@
 //! store never lose each other's files, a kill while a report is replaced leaves the old or
 //! the new report (never neither), and what the binary says when things go wrong.
 
-use igimp::atomic_file::host_tag;
+use igimp::study::atomic_file::host_tag;
 use igimp::study::column::records::ColumnResults;
 use igimp::study::results::read_results;
 use std::path::{Path, PathBuf};

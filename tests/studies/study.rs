@@ -4,12 +4,12 @@
 //!
 //! Everything is written to temporary folders, never to the repository's `reports/`.
 
-use igimp::method::Method;
-use igimp::render::column as report;
+use igimp::basis::method::Method;
 use igimp::study::column::rates::RateRecord;
 use igimp::study::column::records::ColumnResults;
 use igimp::study::column::{ColumnStudy, Measure};
 use igimp::study::engine::{run_in_memory, write_outputs, Run, StudyKind};
+use igimp::study::render::column as report;
 use igimp::study::results::CaseStatus;
 use igimp::study::{StudyError, Tier};
 

@@ -4,8 +4,8 @@
 //! every load step of every case converges quadratically (from the recorded residuals), every
 //! check passes, and the numbers sit where the full-tier reports put them.
 
-use igimp::method::Method;
-use igimp::newton::check_quadratic;
+use igimp::basis::method::Method;
+use igimp::solver::newton::check_quadratic;
 use igimp::study::cantilever::CantileverStudy;
 use igimp::study::compaction::CompactionStudy;
 use igimp::study::engine::{run_in_memory, StudyKind};
@@ -50,7 +50,7 @@ fn compaction_3d_quick_tier_converges_quadratically_and_passes_its_checks() {
     // as not drawn (rendering it without data was an error before, 2026-12-03).
     let tmp = tempfile::tempdir().unwrap();
     let dir = igimp::study::engine::write_outputs(tmp.path(), &run).unwrap();
-    let files = igimp::render::compaction::render(&dir).unwrap().files;
+    let files = igimp::study::render::compaction::render(&dir).unwrap().files;
     assert!(files.iter().any(|f| f.ends_with("fig17.svg")), "{files:?}");
     assert!(!files.iter().any(|f| f.ends_with("families.svg")), "{files:?}");
     let report = std::fs::read_to_string(dir.join("report.md")).unwrap();

@@ -243,7 +243,7 @@ fn vtk_output_read_by_meshio_matches_results_json_and_point_files() {
 /// step; the top displacement read back equals the solver's.
 #[test]
 fn column_3d_writes_points_and_hexahedral_grids_read_by_meshio() {
-    use igimp::method::Method;
+    use igimp::basis::method::Method;
     use igimp::problems::column::{solve_column_observed, ColumnSpec};
     use igimp::study::vtk_output::{ColumnVtkWriter, VtkOptions};
     let tmp = tempfile::tempdir().unwrap();
@@ -489,7 +489,7 @@ fn plane_studies_resume_and_write_vtk() {
     for c in a
         .cases
         .iter()
-        .filter(|c| c.method == igimp::method::Method::IGIMP)
+        .filter(|c| c.method == igimp::basis::method::Method::IGIMP)
     {
         assert!(
             tmp.path()
@@ -654,8 +654,8 @@ fn vtk_3d_domains_are_hexahedra_read_by_meshio() {
         domains: domains.clone(),
         scalars: vec![("sigma_zz".into(), vec![-1.0, -2.0])],
     };
-    let grid = igimp::grid::Grid::<3>::try_new([0.0; 3], [0.5, 1.0, 0.25], [2, 1, 3]).unwrap();
-    let grid = igimp::vtk::background_grid(&grid, &[]);
+    let grid = igimp::mesh::grid::Grid::<3>::try_new([0.0; 3], [0.5, 1.0, 0.25], [2, 1, 3]).unwrap();
+    let grid = igimp::study::vtk::background_grid(&grid, &[]);
     let pvd = write_domain_frames(tmp.path(), "case", &[frame], Some(&grid)).unwrap();
     // The background grid is part 1 of the time step.
     let text = std::fs::read_to_string(&pvd).unwrap();

@@ -6,7 +6,7 @@ use crate::common;
 
 use common::Rng;
 use igimp::basis::{gimp_element_weights, AxisWeights, Basis, GridAxis, Support};
-use igimp::grid::Grid;
+use igimp::mesh::grid::Grid;
 use nalgebra::{SMatrix, SVector};
 
 /// Closed-form uGIMP weight of a node at distance `d` for a domain of half-length `lp <= h/2`

@@ -2,9 +2,9 @@
 //! the MPM-vs-GIMP stress error of Figure 8, and input validation.
 
 use igimp::basis::Basis;
-use igimp::load_stepping::LoadStepping;
-use igimp::newton::{check_quadratic, NewtonSettings};
 use igimp::problems::column::{f_from_cauchy_stress, solve_column, ColumnSpec, Method};
+use igimp::solver::load_stepping::LoadStepping;
+use igimp::solver::newton::{check_quadratic, NewtonSettings};
 
 fn table1_spec(elements: usize) -> ColumnSpec {
     ColumnSpec {
@@ -266,8 +266,8 @@ fn bad_column_input_names_the_field() {
 /// carrying its step and residual history, not a panic.
 #[test]
 fn points_outside_grid_rejected_and_divergence_recorded() {
-    use igimp::grid::Grid;
-    use igimp::particles::MaterialPoints;
+    use igimp::mesh::grid::Grid;
+    use igimp::mpm::particles::MaterialPoints;
     let grid = Grid::try_new([0.0], [1.0], [4]).unwrap();
     let err = MaterialPoints::fill_box(&grid, [0.0], [5.0], [2], 1.0).unwrap_err();
     assert!(err.field.contains("material box"), "{err}");

@@ -2,11 +2,11 @@
 #![allow(dead_code)]
 
 use igimp::basis::Basis;
-use igimp::constitutive::ConstitutiveModel;
-use igimp::ghost::GhostSettings;
-use igimp::kinematics::{left_cauchy_green_from_strain, log_strain, PointState};
+use igimp::discretise::ghost::GhostSettings;
+use igimp::material::constitutive::ConstitutiveModel;
+use igimp::material::kinematics::{left_cauchy_green_from_strain, log_strain, PointState};
 use igimp::mpm::{DomainUpdate, Loads, MpmSettings};
-use igimp::newton::NewtonSettings;
+use igimp::solver::newton::NewtonSettings;
 use nalgebra::{Matrix3, SVector};
 
 /// The settings of the single-state checks (tangents, patches): `basis` with eq (39)'s domain
@@ -77,11 +77,11 @@ impl Rng {
 /// max |K|) and the trial von Mises stresses of its points at that increment, from which the
 /// FEM tangent tests place a yield stress (`fem2d`, `fem3d`).
 pub fn fd_tangent_errors<const D: usize>(
-    sys: &mut igimp::assembly::LoadStepSystem<'_, D>,
+    sys: &mut igimp::discretise::assembly::LoadStepSystem<'_, D>,
     u0_scale: f64,
     seed: u64,
 ) -> (f64, f64, Vec<f64>) {
-    use igimp::newton::NonlinearSystem;
+    use igimp::solver::newton::NonlinearSystem;
     let n = sys.num_unknowns();
     let mut rng = Rng::new(seed);
     let u0: Vec<f64> = (0..n).map(|_| rng.uniform(-u0_scale, u0_scale)).collect();

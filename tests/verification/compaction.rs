@@ -2,9 +2,9 @@
 //! Tables 2 and 3, the weak-node treatment's insensitivity to its tolerance, and failures
 //! recorded rather than panicking.
 
-use igimp::ghost::{GhostFaces, GhostSettings};
-use igimp::newton::{check_quadratic, ResidualNorm};
+use igimp::discretise::ghost::{GhostFaces, GhostSettings};
 use igimp::problems::compaction::{solve_mpm, CompactionSpec};
+use igimp::solver::newton::{check_quadratic, ResidualNorm};
 
 /// Paper Table 2 (elastic, h = 1, 2×2 points, steps 16–20): the normalised out-of-balance
 /// force after Newton iterations 1, 2, 3, with the paper's normalisation (`linearised`:
@@ -239,7 +239,7 @@ fn bad_compaction_input_names_the_field() {
 /// an input error naming `method` and the methods it has.
 #[test]
 fn mpm_weights_solve_the_compaction_and_other_methods_are_named_errors() {
-    use igimp::method::Method;
+    use igimp::basis::method::Method;
     use igimp::problems::compaction::solve;
     let spec = CompactionSpec::default();
     let mpm = solve(&spec, Method::MPM).unwrap();
@@ -286,7 +286,7 @@ fn compaction_3d_quarter_block_converges_quadratically() {
 /// measured 2026-12-01.
 #[test]
 fn compaction_3d_fem_converges_quadratically() {
-    use igimp::method::Method;
+    use igimp::basis::method::Method;
     use igimp::problems::compaction::solve;
     let spec = CompactionSpec {
         dimension: 3,
@@ -327,7 +327,7 @@ fn compaction_3d_fem_converges_quadratically() {
 /// the same Newton iterations; each cell's points are consecutive after the sort.
 #[test]
 fn points_sorted_by_cell_give_the_same_solution() {
-    use igimp::load_stepping::LoadStepping;
+    use igimp::solver::load_stepping::LoadStepping;
     use nalgebra::Vector3;
     let spec = CompactionSpec {
         dimension: 3,

@@ -1,15 +1,15 @@
-//! Implicit dynamics ([`igimp::dynamics`]): the effective tangent K + M/(βΔt²) against central
+//! Implicit dynamics ([`igimp::solver::dynamics`]): the effective tangent K + M/(βΔt²) against central
 //! differences, Newmark's second order in time on the vibrating bar, its period against 4L/c,
 //! its energy, and quadratic Newton with the effective tangent.
 
-use igimp::assembly::LoadStepSystem;
+use igimp::basis::method::Method;
 use igimp::basis::Basis;
-use igimp::dynamics::{MassMatrix, Newmark};
-use igimp::load_stepping::LoadStepping;
-use igimp::method::Method;
+use igimp::discretise::assembly::LoadStepSystem;
 use igimp::mpm::MpmSolver;
-use igimp::newton::{check_quadratic, NonlinearSystem};
 use igimp::problems::bar::{self, BarSpec};
+use igimp::solver::dynamics::{MassMatrix, Newmark};
+use igimp::solver::load_stepping::LoadStepping;
+use igimp::solver::newton::{check_quadratic, NonlinearSystem};
 
 /// max |K − K_fd| / max |K| of a step's system at a deterministic increment of size `scale`.
 pub fn fd_error<const D: usize>(sys: &mut LoadStepSystem<'_, D>, scale: f64) -> f64 {
@@ -88,7 +88,7 @@ fn newton_converges_quadratically_with_the_effective_tangent() {
                 steps_per_period: 32,
                 periods: 0.5,
                 mass,
-                newton: igimp::newton::NewtonSettings {
+                newton: igimp::solver::newton::NewtonSettings {
                     tolerance: 1e-11,
                     max_iterations: 30,
                     ..Default::default()
@@ -328,7 +328,7 @@ fn plane_and_solid_effective_tangents_match_central_differences() {
                 gravity: SVector::<f64, 3>::new(0.0, 0.0, -0.5),
                 nodal_forces: vec![],
             };
-            let model = Box::new(igimp::constitutive::LinearElastic::try_new(1.0, 0.3).unwrap());
+            let model = Box::new(igimp::material::constitutive::LinearElastic::try_new(1.0, 0.3).unwrap());
             let settings = igimp::fem::PlaneFemSettings {
                 load_steps: 8,
                 ..Default::default()
@@ -357,7 +357,7 @@ fn plane_and_solid_effective_tangents_match_central_differences() {
 /// Least-squares slope of log e against log(1/n).
 fn slope(levels: &[usize], errors: &[f64]) -> f64 {
     let h: Vec<f64> = levels.iter().map(|&n| 1.0 / n as f64).collect();
-    igimp::norms::fitted_rate(&h, errors).expect("a rate")
+    igimp::problems::norms::fitted_rate(&h, errors).expect("a rate")
 }
 
 /// The dynamic axis-aligned field on `cells` cells at `steps` per period, Newmark (`None`) or

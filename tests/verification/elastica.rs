@@ -181,7 +181,7 @@ fn elastica_bending_stiffness() {
 /// Bad input is rejected with an error naming the field.
 #[test]
 fn elastica_rejects_bad_input() {
-    let field = |r: Result<TipDisplacement, igimp::error::InputError>| r.unwrap_err().field;
+    let field = |r: Result<TipDisplacement, igimp::solver::error::InputError>| r.unwrap_err().field;
     assert_eq!(field(tip_elliptic(-1.0)), "alpha");
     assert_eq!(field(tip_elliptic(f64::NAN)), "alpha");
     assert_eq!(field(tip_elliptic(f64::INFINITY)), "alpha");

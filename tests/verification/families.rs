@@ -5,16 +5,16 @@
 //! family on the column and the compaction.
 
 use crate::common::Rng;
+use igimp::basis::method::Method;
 use igimp::basis::{
     cpdi, Basis, BasisFamily, BsplineKernel, PointSupport, PointView, SplineBoundary, SplineDegree,
     TensorProduct,
 };
-use igimp::grid::Grid;
-use igimp::method::Method;
-use igimp::newton::check_quadratic;
-use igimp::particles::MaterialPoints;
+use igimp::mesh::grid::Grid;
+use igimp::mpm::particles::MaterialPoints;
 use igimp::problems::column::{solve_column, ColumnSpec};
 use igimp::problems::compaction::{self, CompactionSpec};
+use igimp::solver::newton::check_quadratic;
 use nalgebra::{Matrix3, SMatrix, SVector};
 
 /// The worst (partition of unity, gradient sum, Σ S x_v − x̄, Σ x_v ⊗ ∇S − A) over `support`,
@@ -302,14 +302,14 @@ fn a_family_defined_outside_the_crate_runs_the_column() {
 }
 
 /// Nodes some point of `points` reaches with `family` that are a node of no cell with a
-/// positive ghost fill ([`igimp::ghost::cell_fill`]): the ghost penalty cannot see them.
+/// positive ghost fill ([`igimp::mpm::cell_fill::cell_fill`]): the ghost penalty cannot see them.
 fn nodes_unseen_by_the_ghost(
     family: &dyn BasisFamily<2>,
     points: &MaterialPoints<2>,
     grid: &Grid<2>,
 ) -> usize {
     let mut fill = vec![];
-    igimp::ghost::cell_fill(grid, family, points, &mut fill);
+    igimp::mpm::cell_fill::cell_fill(grid, family, points, &mut fill);
     let c = grid.cells();
     let mut seen = vec![false; grid.num_nodes()];
     for (cell, &phi) in fill.iter().enumerate() {

@@ -4,13 +4,13 @@
 //!
 //! Run in release mode: `cargo test --release --test fem`.
 
-use igimp::constitutive::LinearElastic;
 use igimp::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
-use igimp::load_stepping::LoadStepping;
-use igimp::newton::{observed_order, NewtonSettings, NonlinearSystem};
-use igimp::norms::fitted_rate;
+use igimp::material::constitutive::LinearElastic;
+use igimp::mesh::quadrature::GaussRule;
 use igimp::problems::column::{f_from_cauchy_stress, ColumnOutcome, ColumnSpec};
-use igimp::quadrature::GaussRule;
+use igimp::problems::norms::fitted_rate;
+use igimp::solver::load_stepping::LoadStepping;
+use igimp::solver::newton::{observed_order, NewtonSettings, NonlinearSystem};
 
 /// The §5.1 column at W = 400,000 (Figures 10–11, Table 1) with `elements` elements.
 fn heavy_column(elements: usize, gauss_points: Option<usize>) -> ColumnSpec {

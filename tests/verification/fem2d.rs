@@ -12,11 +12,11 @@
 use crate::common;
 
 use common::Rng;
-use igimp::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
 use igimp::fem::{ElementFamily, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
-use igimp::linear::LinearSolver;
-use igimp::load_stepping::LoadStepping;
-use igimp::newton::{check_quadratic, NonlinearSystem};
+use igimp::material::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
+use igimp::solver::linear::LinearSolver;
+use igimp::solver::load_stepping::LoadStepping;
+use igimp::solver::newton::{check_quadratic, NonlinearSystem};
 use nalgebra::{Matrix2, Matrix3, SVector};
 
 type V2 = SVector<f64, 2>;
@@ -568,7 +568,7 @@ fn cantilever_tip(nx: usize, ny: usize, p: f64, clamp_all: bool) -> f64 {
     // 1e-8), so the tolerance is 1e-6. The problem is linear to ~1e-5 (tip rotation ~5e-5).
     let settings = PlaneFemSettings {
         linear_solver: LinearSolver::Ldlt,
-        newton: igimp::newton::NewtonSettings {
+        newton: igimp::solver::newton::NewtonSettings {
             tolerance: 1e-6,
             max_iterations: 10,
             line_search: false,

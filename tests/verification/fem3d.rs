@@ -9,9 +9,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::common::Rng;
-use igimp::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
 use igimp::fem::{ElementFamily, HexElement, HexMesh, SolidFem, SolidLoads};
-use igimp::newton::NonlinearSystem;
+use igimp::material::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
+use igimp::solver::newton::NonlinearSystem;
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 
 type V3 = Vector3<f64>;
@@ -135,7 +135,7 @@ fn hex_mesh_counts_volume_and_face_lookup() {
         };
         assert_eq!(mesh.num_nodes(), expect, "{element:?} node count");
         assert_eq!(mesh.num_elements(), nx * ny * nz);
-        let rule = igimp::quadrature::tensor_rule::<3>(element.default_gauss_points()).unwrap();
+        let rule = igimp::mesh::quadrature::tensor_rule::<3>(element.default_gauss_points()).unwrap();
         let volume: f64 = (0..mesh.num_elements())
             .map(|e| {
                 rule.iter()

@@ -5,10 +5,10 @@
 //! same inputs every time; a failure is saved to `proptest-regressions/hostile.txt` (commit it)
 //! and replayed first on the next run.
 
-use igimp::newton::NewtonSettings;
 use igimp::problems::cantilever::CantileverSpec;
 use igimp::problems::column::{solve_column, ColumnSpec, Method};
 use igimp::problems::compaction::CompactionSpec;
+use igimp::solver::newton::NewtonSettings;
 use igimp::study::column::ColumnStudy;
 use igimp::study::engine::StudyKind;
 use igimp::study::store::confined;
@@ -451,7 +451,7 @@ fn newton() -> impl Strategy<Value = NewtonSettings> {
 /// Run `f` in `catch_unwind`; a panic fails the property, an error must name a field.
 fn no_panic<T>(
     what: &str,
-    f: impl FnOnce() -> Result<T, igimp::error::InputError>,
+    f: impl FnOnce() -> Result<T, igimp::solver::error::InputError>,
 ) -> Result<Option<T>, TestCaseError> {
     match catch_unwind(AssertUnwindSafe(f)) {
         Err(_) => Err(TestCaseError::fail(format!("{what} panicked"))),
@@ -521,7 +521,7 @@ proptest! {
         };
         let solver = no_panic("CompactionSpec::mpm_solver", || spec.mpm_solver())?;
         if let Some(mut s) = solver {
-            use igimp::load_stepping::LoadStepping;
+            use igimp::solver::load_stepping::LoadStepping;
             if s.points.len() <= 200 && s.grid.num_nodes() <= 400 && newton.max_iterations <= 40 {
                 let _ = catch_unwind(AssertUnwindSafe(|| s.step()))
                     .map_err(|_| TestCaseError::fail(format!("compaction step panicked: {spec:?}")))?;

@@ -3,8 +3,8 @@
 //! force b₀ = −Div P against central differences of P, det F = 1 for the vortex, and b₀ = 0
 //! where the vortex does not move.
 
-use igimp::constitutive::{ConstitutiveModel, LinearElastic, MaterialState};
-use igimp::kinematics::log_strain;
+use igimp::material::constitutive::{ConstitutiveModel, LinearElastic, MaterialState};
+use igimp::material::kinematics::log_strain;
 use igimp::problems::manufactured::{deformation_gradient, motion, Exact, Field, ManufacturedSpec};
 use nalgebra::Matrix3;
 use num_dual::Dual64;
@@ -141,9 +141,9 @@ fn vortex_is_still_outside_its_core() {
 /// measured slopes ± 0.3.
 #[test]
 fn exact_field_residual_converges() {
-    use igimp::method::Method;
-    use igimp::newton::{NonlinearSystem, ResidualNorm};
+    use igimp::basis::method::Method;
     use igimp::problems::manufactured::{fem_solver, mpm_solver};
+    use igimp::solver::newton::{NonlinearSystem, ResidualNorm};
     let residual = |field: Field, method: Method, n: usize| -> f64 {
         let spec = ManufacturedSpec {
             field,
@@ -156,7 +156,7 @@ fn exact_field_residual_converges() {
             let y = e.position(x);
             [y[0] - x[0], y[1] - x[1]]
         };
-        let norm = |sys: &mut igimp::assembly::LoadStepSystem<'_, 2>, nodal: &[f64]| {
+        let norm = |sys: &mut igimp::discretise::assembly::LoadStepSystem<'_, 2>, nodal: &[f64]| {
             let mut u = vec![0.0; sys.num_unknowns()];
             sys.dofs.gather(nodal, &mut u);
             let mut r = vec![0.0; u.len()];
@@ -191,7 +191,7 @@ fn exact_field_residual_converges() {
     ] {
         let r: Vec<f64> = [8, 16, 32].iter().map(|&n| residual(field, method, n)).collect();
         let h = [1.0 / 8.0, 1.0 / 16.0, 1.0 / 32.0];
-        let slope = igimp::norms::fitted_rate(&h, &r).unwrap();
+        let slope = igimp::problems::norms::fitted_rate(&h, &r).unwrap();
         report.push(format!(
             "{field:?} {method:?}: {:.3e} {:.3e} {:.3e} slope {slope:.2}",
             r[0], r[1], r[2]
@@ -265,7 +265,7 @@ fn manufactured_3d_exact_solution_is_consistent() {
 /// relative).
 #[test]
 fn manufactured_3d_vortex_equals_the_plane_strain_run() {
-    use igimp::method::Method;
+    use igimp::basis::method::Method;
     use igimp::problems::manufactured::solve;
     use igimp::problems::manufactured3d::solve_3d;
     let spec = ManufacturedSpec {
@@ -290,7 +290,7 @@ fn manufactured_3d_vortex_equals_the_plane_strain_run() {
 /// runs at 4³ and 8³: at most 3e-15 relative).
 #[test]
 fn every_family_3d_vortex_equals_the_plane_strain_run() {
-    use igimp::method::Method;
+    use igimp::basis::method::Method;
     use igimp::problems::manufactured::solve;
     use igimp::problems::manufactured3d::solve_3d;
     let spec = ManufacturedSpec {

@@ -1,18 +1,18 @@
 //! The geometric multigrid and the conjugate-gradient solver behind
-//! `LinearSolver::Iterative` (`src/multigrid.rs`): the prolongation reproduces linear fields, the
+//! `LinearSolver::Iterative` (`src/solver/multigrid.rs`): the prolongation reproduces linear fields, the
 //! Galerkin coarse operators stay symmetric positive definite, CG agrees with the direct
 //! solver to the Newton tolerance on the paper's examples with Newton still quadratic, and
 //! the iteration counts stay bounded under refinement.
 
 use igimp::fem::QuadElement;
-use igimp::krylov::{gmres, pcg};
-use igimp::linear::LinearSolver;
-use igimp::load_stepping::{LoadStepping, StepReport};
 use igimp::mpm::MpmSolver;
-use igimp::multigrid::{prolongation, DofGeometry, Hierarchy};
-use igimp::newton::check_quadratic;
 use igimp::problems::compaction::{fem_solver, CompactionSpec};
-use igimp::sparse::Csr;
+use igimp::solver::krylov::{gmres, pcg};
+use igimp::solver::linear::LinearSolver;
+use igimp::solver::load_stepping::{LoadStepping, StepReport};
+use igimp::solver::multigrid::{prolongation, DofGeometry, Hierarchy};
+use igimp::solver::newton::check_quadratic;
+use igimp::solver::sparse::Csr;
 
 /// A 1D operator on 4,096 nodes of spacing h: −u'' + c u' − σ u by central differences, as a
 /// row-compressed matrix with its multigrid geometry.
@@ -270,7 +270,7 @@ fn cg_agrees_with_the_direct_solver_on_the_material_point_examples() {
     // falling as 1/n² with fewer).
     let spec = ColumnSpec {
         elements: 2048,
-        newton: igimp::newton::NewtonSettings {
+        newton: igimp::solver::newton::NewtonSettings {
             tolerance: 1e-8,
             ..Default::default()
         },

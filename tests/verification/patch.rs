@@ -3,14 +3,14 @@
 //! no internal force (uniform stress is in equilibrium), for MPM and GIMP in 1D and 2D.
 
 use crate::common;
-use igimp::assembly::{DofMap, LoadStepSystem};
 use igimp::basis::Basis;
-use igimp::constitutive::LinearElastic;
-use igimp::grid::Grid;
-use igimp::linear::SparseSystem;
+use igimp::discretise::assembly::{DofMap, LoadStepSystem};
+use igimp::material::constitutive::LinearElastic;
+use igimp::mesh::grid::Grid;
+use igimp::mpm::particles::MaterialPoints;
 use igimp::mpm::MpmSolver;
-use igimp::newton::NonlinearSystem;
-use igimp::particles::MaterialPoints;
+use igimp::solver::linear::SparseSystem;
+use igimp::solver::newton::NonlinearSystem;
 use nalgebra::SMatrix;
 
 fn patch<const D: usize>(

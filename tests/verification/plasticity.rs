@@ -6,12 +6,12 @@ use crate::common;
 
 use common::Rng;
 use igimp::basis::Basis;
-use igimp::constitutive::{ConstitutiveModel, MaterialState, VonMises};
-use igimp::kinematics::{evaluate_point, left_cauchy_green_from_strain, PointState};
-use igimp::load_stepping::LoadStepping;
-use igimp::newton::{check_quadratic, NewtonSettings};
+use igimp::material::constitutive::{ConstitutiveModel, MaterialState, VonMises};
+use igimp::material::kinematics::{evaluate_point, left_cauchy_green_from_strain, PointState};
+use igimp::material::tensor::contract;
 use igimp::problems::column::{solve_column, yield_height_estimate, ColumnSpec, Method};
-use igimp::tensor::contract;
+use igimp::solver::load_stepping::LoadStepping;
+use igimp::solver::newton::{check_quadratic, NewtonSettings};
 use nalgebra::{Matrix2, Matrix3, SMatrix};
 
 const RHO_Y: f64 = 3e4;
@@ -46,7 +46,7 @@ fn von_mises_return_map_lands_on_yield_surface_and_elastic_states_pass() {
             elastic += 1;
             assert!(f <= 0.0);
             assert_eq!(r.eps_e, eps);
-            let lin = igimp::constitutive::LinearElastic::try_new(1e6, 0.3).unwrap();
+            let lin = igimp::material::constitutive::LinearElastic::try_new(1e6, 0.3).unwrap();
             assert_eq!(m.tangent(&eps, &MaterialState::default()), *lin.stiffness());
         }
     }
@@ -68,7 +68,7 @@ fn von_mises_algorithmic_tangent_matches_central_differences() {
         let eps = random_strain(&mut rng, 0.05);
         let r = m.update(&eps, &state).unwrap();
         let d_alg = m.tangent(&eps, &state);
-        let elastic = igimp::constitutive::LinearElastic::try_new(1e6, 0.3).unwrap();
+        let elastic = igimp::material::constitutive::LinearElastic::try_new(1e6, 0.3).unwrap();
         let trial_margin = m.yield_function(&contract(elastic.stiffness(), &eps));
         if trial_margin.abs() < 1e-3 * RHO_Y {
             continue; // too close to the elastic/plastic kink for differences
@@ -249,7 +249,7 @@ fn gimp_plastic_column_converges_to_analytical_solution() {
         zy_errs.push(zy_err);
         last_zy = zy_h;
     }
-    let rate = igimp::norms::fitted_rate(&hs, &zy_errs).unwrap();
+    let rate = igimp::problems::norms::fitted_rate(&hs, &zy_errs).unwrap();
     assert!(rate >= 0.7, "yield height convergence rate {rate}");
     assert!(
         (last_zy - 46.25).abs() > 50.0 * zy_errs[zy_errs.len() - 1],

@@ -1,10 +1,10 @@
 //! Robustness without bias (reference/README.md items 15-21): one point per cell with the ghost term on every face,
 //! adaptive load stepping, and the Newton stall diagnosis.
 
-use igimp::error::StepFailure;
-use igimp::ghost::{GhostFaces, GhostSettings};
+use igimp::discretise::ghost::{GhostFaces, GhostSettings};
 use igimp::problems::column::{solve_column, ColumnSpec, Method};
 use igimp::problems::compaction::{solve_mpm, CompactionSpec};
+use igimp::solver::error::StepFailure;
 
 /// The W = 400,000 column of Table 1 with one point per cell.
 fn one_point_column(elements: usize, ghost: GhostSettings) -> ColumnSpec {

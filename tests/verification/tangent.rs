@@ -5,18 +5,18 @@
 use crate::common;
 
 use common::Rng;
-use igimp::assembly::{DofMap, LoadStepSystem};
 use igimp::basis::Basis;
-use igimp::constitutive::{ConstitutiveModel, LinearElastic, MaterialState};
-use igimp::grid::Grid;
-use igimp::kinematics::{dlog, evaluate_point, log_strain, sym_eigen, PointState};
-use igimp::linear::SparseSystem;
-use igimp::load_stepping::LoadStepping;
+use igimp::discretise::assembly::{DofMap, LoadStepSystem};
+use igimp::material::constitutive::{ConstitutiveModel, LinearElastic, MaterialState};
+use igimp::material::kinematics::{dlog, evaluate_point, log_strain, sym_eigen, PointState};
+use igimp::material::tensor::{contract, ij};
+use igimp::mesh::grid::Grid;
+use igimp::mpm::particles::MaterialPoints;
 use igimp::mpm::MpmSolver;
-use igimp::newton::NonlinearSystem;
-use igimp::particles::MaterialPoints;
 use igimp::problems::column::ColumnSpec;
-use igimp::tensor::{contract, ij};
+use igimp::solver::linear::SparseSystem;
+use igimp::solver::load_stepping::LoadStepping;
+use igimp::solver::newton::NonlinearSystem;
 use nalgebra::{Matrix2, Matrix3, SMatrix, SVector};
 
 fn random_spd(rng: &mut Rng, spread: f64) -> Matrix3<f64> {
@@ -204,7 +204,7 @@ fn gimp_1d_global_tangent_matches_central_differences() {
 /// (F_n = R U), evaluated at a random trial increment.
 #[test]
 fn gimp_2d_global_tangent_matches_central_differences_rotated_stretched_state() {
-    use igimp::ghost::{GhostFaces, GhostSettings};
+    use igimp::discretise::ghost::{GhostFaces, GhostSettings};
     let off = GhostSettings::default();
     let all = GhostSettings {
         gamma: 0.5,
@@ -303,7 +303,7 @@ fn stress_update_is_objective_under_superposed_rotation() {
 /// eigen-decomposition reconstructs b.
 #[test]
 fn spatial_tangent_eigen_form_equals_literal_eq25() {
-    use igimp::kinematics::{spatial_tangent, spatial_tangent_eigen};
+    use igimp::material::kinematics::{spatial_tangent, spatial_tangent_eigen};
     let model = LinearElastic::try_new(3e4, 0.2).unwrap();
     let mut rng = Rng::new(41);
     for case in 0..40 {
@@ -356,7 +356,7 @@ fn gimp_3d_global_tangent_matches_central_differences_rotated_stretched_plastic_
 /// unchanged), at random stretched and sheared increments.
 #[test]
 fn stress_update_is_objective_under_oblique_rotation_3d() {
-    use igimp::constitutive::VonMises;
+    use igimp::material::constitutive::VonMises;
     use nalgebra::{Rotation3, Unit, Vector3};
     let models: [Box<dyn ConstitutiveModel>; 2] = [
         Box::new(LinearElastic::try_new(1e5, 0.25).unwrap()),
@@ -388,7 +388,7 @@ fn stress_update_is_objective_under_oblique_rotation_3d() {
 /// stress 2e3: every trial state is far outside the surface), fixed on its lower face along
 /// the last axis.
 fn stretched_block<const D: usize>(basis: Basis, plastic: bool) -> MpmSolver<D> {
-    use igimp::constitutive::VonMises;
+    use igimp::material::constitutive::VonMises;
     let model: Box<dyn ConstitutiveModel> = if plastic {
         Box::new(VonMises::try_new(1e5, 0.3, 2e3).unwrap())
     } else {
@@ -404,7 +404,7 @@ fn stretched_block_of<const D: usize>(
     plastic: bool,
     model: Box<dyn ConstitutiveModel>,
 ) -> MpmSolver<D> {
-    use igimp::constitutive::VonMises;
+    use igimp::material::constitutive::VonMises;
     use nalgebra::{Rotation3, Unit, Vector3};
     let grid = Grid::try_new([0.0; D], [1.0; D], [4; D]).unwrap();
     let mut points = MaterialPoints::fill_box(&grid, [1.0; D], [3.0; D], [2; D], 10.0).unwrap();
@@ -538,10 +538,15 @@ impl ConstitutiveModel for Skewed {
         &self,
         eps_trial: &Matrix3<f64>,
         committed: &MaterialState,
-    ) -> Result<igimp::constitutive::MaterialResponse, igimp::constitutive::MaterialError> {
+    ) -> Result<igimp::material::constitutive::MaterialResponse, igimp::material::constitutive::MaterialError>
+    {
         self.0.update(eps_trial, committed)
     }
-    fn tangent(&self, eps_trial: &Matrix3<f64>, committed: &MaterialState) -> igimp::tensor::Tensor4 {
+    fn tangent(
+        &self,
+        eps_trial: &Matrix3<f64>,
+        committed: &MaterialState,
+    ) -> igimp::material::tensor::Tensor4 {
         let mut d = self.0.tangent(eps_trial, committed);
         let e = self.0.young_modulus();
         for (i, j, v) in [(0, 4, 0.3), (1, 8, -0.2), (3, 5, 0.1)] {
@@ -562,8 +567,8 @@ impl ConstitutiveModel for Skewed {
 /// symmetric, so a dense block added by rows untransposed would fail.
 #[test]
 fn tangent_by_rows_equals_tangent_by_columns_to_the_bit() {
-    use igimp::ghost::{GhostFaces, GhostSettings};
-    use igimp::linear::LinearSolver;
+    use igimp::discretise::ghost::{GhostFaces, GhostSettings};
+    use igimp::solver::linear::LinearSolver;
     let dense = |solver: &mut MpmSolver<3>| {
         assembled_at(solver, 0.05, 26, false, |sys, u0| {
             let n = u0.len();

@@ -321,7 +321,7 @@ pub(super) fn refinement_rows(study: &CantileverStudy, records: &[CantileverReco
 fn gci_of(
     rows: &[RefinementRow],
     refinement: &str,
-    method: crate::method::Method,
+    method: crate::basis::method::Method,
     measure: &str,
     value: fn(&RefinementRow) -> Option<f64>,
 ) -> GciRecord {

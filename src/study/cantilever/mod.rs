@@ -18,7 +18,7 @@ mod plan;
 pub mod records;
 
 use super::vocabulary::{GhostSection, NewtonSection, WeakNodeSection};
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::mpm::{DomainUpdate, VolumeUpdate};
 use crate::problems::cantilever::CantileverSpec;
 use serde::{Deserialize, Serialize};

@@ -363,7 +363,7 @@ impl CantileverStudy {
     }
 
     /// The id of `method`'s case at element size `h` in refinement `id`.
-    pub fn refinement_case_id(id: &str, method: crate::method::Method, h: f64) -> String {
+    pub fn refinement_case_id(id: &str, method: crate::basis::method::Method, h: f64) -> String {
         format!("{id}-{}-h{h}", method.name())
     }
 

@@ -2,7 +2,7 @@
 //! the kind's measures. The kind fills them, the checks and the renderer read them.
 
 use super::CantileverStudy;
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::mpm::{DomainUpdate, VolumeUpdate};
 use crate::problems::cantilever::EndDisplacement;
 use crate::study::results::{case_record, Envelope, SolveRecord};

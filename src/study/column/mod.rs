@@ -10,14 +10,14 @@ mod validate;
 use super::results::SweepIndex;
 use super::vocabulary::{weight_label, NewtonSection};
 use super::Tier;
-use crate::method::Method;
-use crate::newton::NewtonSettings;
+use crate::basis::method::Method;
 use crate::problems::column::ColumnSpec;
+use crate::solver::newton::NewtonSettings;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
 
 /// The `problem` of a column study file: the elastic and the plastic column of §5.1
-/// ([`crate::kinds`] dispatches every kind on this key).
+/// ([`crate::study::kinds`] dispatches every kind on this key).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ProblemKind {
@@ -249,7 +249,7 @@ pub struct ColumnStudy {
     pub paper: Vec<PaperRows>,
     #[serde(default)]
     pub figures: Vec<FigureSpec>,
-    /// Ghost stabilisation of one point per cell ([`crate::ghost`]); absent: none.
+    /// Ghost stabilisation of one point per cell ([`crate::discretise::ghost`]); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ghost: Option<ColumnGhost>,
     /// 1 (default) or 3: the column as a 1 × 1 × n prism with lateral rollers
@@ -272,7 +272,7 @@ fn is_one(d: &i64) -> bool {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ColumnGhost {
-    pub one_point_per_cell: crate::ghost::GhostSettings,
+    pub one_point_per_cell: crate::discretise::ghost::GhostSettings,
 }
 
 /// One case to solve.
@@ -347,7 +347,7 @@ impl ColumnStudy {
             newton: plan.newton,
             ghost: match (ppc, self.ghost, plan.untreated) {
                 (1, Some(g), false) => g.one_point_per_cell,
-                _ => crate::ghost::GhostSettings::default(),
+                _ => crate::discretise::ghost::GhostSettings::default(),
             },
             dimension: self.dimension.max(1) as usize,
             ..ColumnSpec::default()
@@ -369,7 +369,7 @@ impl ColumnStudy {
         id.push_str(&format!("-s{}", spec.load_steps));
         let treated = match (ppc, self.ghost) {
             (Some(1), Some(g)) => g.one_point_per_cell,
-            _ => crate::ghost::GhostSettings::default(),
+            _ => crate::discretise::ghost::GhostSettings::default(),
         };
         if spec.ghost != treated {
             id.push_str("-untreated");

@@ -1,14 +1,14 @@
 //! Convergence rates of the sweeps and the checks declared in the study file.
 //!
 //! A rate is the least-squares slope of log(error) against log(h), h = L0 / elements
-//! ([`crate::norms::fitted_rate`]), over the finest `fit_points` converged element counts of
+//! ([`crate::problems::norms::fitted_rate`]), over the finest `fit_points` converged element counts of
 //! one series (method, weight, points per cell). Pairwise log2 rates per refinement are
 //! computed by [`pairwise_rates`] for the tables.
 
 use super::records::ColumnRecord;
 pub use super::records::{ComparisonRecord, ExpectedBand, RateRecord};
 use super::{ColumnStudy, Measure};
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::study::checks::fitted_rate_finest;
 use crate::study::results::{CaseStatus, SweepIndex};
 use crate::study::Tier;

@@ -3,8 +3,8 @@
 //! reads it only.
 
 use super::{ColumnStudy, Measure};
-use crate::method::Method;
-use crate::newton::NewtonSettings;
+use crate::basis::method::Method;
+use crate::solver::newton::NewtonSettings;
 use crate::study::results::{case_record, Envelope, SolveRecord};
 use serde::{Deserialize, Serialize};
 

@@ -2,7 +2,7 @@
 //! range ([`Checker`]).
 
 use super::{ColumnStudy, FigureKind, Sweep};
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::study::vocabulary::{max_points_per_axis, short, Checker, Header};
 use crate::study::StudyError;
 use std::collections::BTreeSet;

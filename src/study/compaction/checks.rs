@@ -3,7 +3,7 @@
 //! expectations (deviation, convergence, weak-node and ghost spreads).
 
 use super::records::{CompactionRecord, CompactionResults, ReferenceRecord};
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::study::checks::{check_at_most, relative_spread, richardson, CheckRecord, GciRecord};
 use crate::study::results::CaseStatus;
 use crate::study::vocabulary::{number, points_grid};

@@ -4,7 +4,7 @@
 
 use super::records::{CompactionMeasures, CompactionRecord};
 use super::{CompactionCase, CompactionFigureKind, CompactionStudy};
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::problems::compaction::{solve, Domain3dRecord, DomainRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};

@@ -15,7 +15,7 @@ mod plan;
 pub mod records;
 
 use super::vocabulary::{GhostSection, NewtonSection, WeakNodeSection};
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::problems::compaction::CompactionSpec;
 use serde::{Deserialize, Serialize};
 
@@ -89,11 +89,11 @@ pub struct CompactionSweep {
     /// Ghost penalty factors γ (0 = off); defaults to the `[ghost]` section's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ghost_gammas: Option<Vec<f64>>,
-    /// `cg`: the multigrid-preconditioned conjugate gradients ([`crate::linear::LinearSolver::Iterative`]) for
+    /// `cg`: the multigrid-preconditioned conjugate gradients ([`crate::solver::linear::LinearSolver::Iterative`]) for
     /// every case of the sweep (ids gain `-cg`); absent: the direct default (LU for the
     /// material point methods, LDLᵀ for FEM).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub linear_solver: Option<crate::linear::LinearSolver>,
+    pub linear_solver: Option<crate::solver::linear::LinearSolver>,
     #[serde(default)]
     pub quick: SweepQuick,
 }

@@ -3,7 +3,7 @@
 //! and ids.
 
 use super::{CompactionCase, CompactionFigureKind, CompactionStudy, CompactionSweep};
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::problems::compaction::{methods, CompactionSpec};
 use crate::study::engine::distinct_cases;
 use crate::study::results::SweepIndex;
@@ -241,7 +241,7 @@ impl CompactionStudy {
             Some(y) => format!("vm{}", number(y)),
         };
         let mut id = format!("{}-{material}-h{}", method.name(), number(spec.element_size));
-        if spec.linear_solver == crate::linear::LinearSolver::Iterative {
+        if spec.linear_solver == crate::solver::linear::LinearSolver::Iterative {
             id.push_str("-cg");
         }
         if !method.is_fem() {

@@ -2,7 +2,7 @@
 //! the kind's measures. The kind fills them, the checks and the renderer read them.
 
 use super::CompactionStudy;
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::study::results::{case_record, Envelope, SolveRecord};
 use serde::{Deserialize, Serialize};
 
@@ -20,7 +20,7 @@ pub struct CompactionRecord {
     /// Ghost penalty factor γ of the case (0: off; FEM: 0).
     pub ghost_gamma: f64,
     /// Faces carrying the ghost penalty (`cut` or `all`).
-    pub ghost_faces: crate::ghost::GhostFaces,
+    pub ghost_faces: crate::discretise::ghost::GhostFaces,
     /// Load steps that needed cutbacks, and the failed attempts in all.
     pub steps_cut: usize,
     pub cutbacks: usize,

@@ -8,10 +8,10 @@
 use super::records::{DynamicMeasures, DynamicRecord, DynamicResults, ExpectedBand, RateRecord, Series};
 use super::{BarCase, BarReferenceRun, CantileverCase, CaseSpec, ReferenceRun};
 use super::{DynamicCase, DynamicMeasure, DynamicStudy, FigureKind, Refinement};
-use crate::load_stepping::StepReport;
 use crate::problems::bar::{self, BarSpec};
 use crate::problems::cantilever_dynamic::{self, DynamicCantileverOutcome};
 use crate::problems::manufactured_dynamic::{self, DynamicManufacturedSpec};
+use crate::solver::load_stepping::StepReport;
 use crate::study::checks::{check_at_most, check_rate, CheckRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{write_case_data, SolveRecord, SweepIndex};
@@ -54,8 +54,8 @@ fn cached<T: Send + Sync + 'static>(key: String, solve: impl FnOnce() -> T) -> A
 
 /// A reference analysis' outcome, or why it has none (rejected, or failed at a step).
 fn reference_result<O>(
-    method: crate::method::Method,
-    solved: Result<O, crate::error::InputError>,
+    method: crate::basis::method::Method,
+    solved: Result<O, crate::solver::error::InputError>,
     failure: impl Fn(&O) -> Option<(usize, String)>,
 ) -> Result<O, String> {
     let o = solved.map_err(|e| format!("reference {} rejected: {e}", method.name()))?;
@@ -357,7 +357,7 @@ fn rates(results: &DynamicResults) -> Vec<RateRecord> {
                     .collect();
                 let h: Vec<f64> = pts.iter().map(|p| p.1).collect();
                 let e: Vec<f64> = pts.iter().map(|p| p.2).collect();
-                let slope = crate::norms::fitted_rate(&h, &e);
+                let slope = crate::problems::norms::fitted_rate(&h, &e);
                 let expected = study
                     .expect_rate
                     .iter()

@@ -12,13 +12,13 @@ pub mod records;
 
 use super::vocabulary::{Checker, Header, NewtonSection};
 use super::{StudyError, Tier};
-use crate::dynamics::MassMatrix;
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::problems::bar::BarSpec;
 use crate::problems::cantilever::CantileverSpec;
 use crate::problems::cantilever_dynamic::DynamicCantileverSpec;
 use crate::problems::manufactured::Field;
 use crate::problems::manufactured_dynamic::{self, DynamicManufacturedSpec};
+use crate::solver::dynamics::MassMatrix;
 use crate::study::engine::distinct_cases;
 use crate::study::results::SweepIndex;
 use serde::{Deserialize, Serialize};
@@ -378,7 +378,7 @@ fn through_depth(s: &DynamicCantileverSpec) -> usize {
 }
 
 impl CaseSpec {
-    pub fn validate(&self) -> Result<(), crate::error::InputError> {
+    pub fn validate(&self) -> Result<(), crate::solver::error::InputError> {
         match self {
             CaseSpec::Bar(b) => b.validate(),
             CaseSpec::Manufactured(m) => m.validate(),

@@ -2,8 +2,8 @@
 //! (errors; the bar's period and energy) and the fitted rates.
 
 use super::{DynamicMeasure, DynamicStudy, Refinement};
-use crate::dynamics::MassMatrix;
-use crate::method::Method;
+use crate::basis::method::Method;
+use crate::solver::dynamics::MassMatrix;
 use crate::study::results::{case_record, Envelope, SolveRecord};
 use serde::{Deserialize, Serialize};
 

@@ -5,8 +5,8 @@
 
 use super::records::{CasePoints, ManufacturedMeasures, ManufacturedRecord};
 use super::{FigureKind, ManufacturedCase, ManufacturedStudy};
-use crate::grid::Grid;
-use crate::method::Method;
+use crate::basis::method::Method;
+use crate::mesh::grid::Grid;
 use crate::problems::manufactured::{solve, stress_deviations, Errors, Exact, PointValue};
 use crate::problems::manufactured3d::{solve_3d, stress_deviations_3d, Exact3, PointValue3};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};

@@ -10,7 +10,7 @@ mod plan;
 pub mod records;
 
 use super::vocabulary::NewtonSection;
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::mpm::DomainUpdate;
 pub use crate::problems::manufactured::Field;
 use crate::problems::manufactured::ManufacturedSpec;

@@ -2,7 +2,7 @@
 //! their ids.
 
 use super::{FigureKind, ManufacturedCase, ManufacturedStudy, ManufacturedSweep};
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::mpm::DomainUpdate;
 use crate::problems::manufactured::{Field, ManufacturedSpec, METHODS};
 use crate::problems::manufactured3d::METHODS_3D;

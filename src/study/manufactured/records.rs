@@ -2,7 +2,7 @@
 //! records (the two error measures) and the fitted rates.
 
 use super::{ErrorMeasure, ManufacturedStudy};
-use crate::method::Method;
+use crate::basis::method::Method;
 use crate::mpm::DomainUpdate;
 use crate::problems::manufactured::{Field, PointValue};
 use crate::problems::manufactured3d::PointValue3;

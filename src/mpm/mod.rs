@@ -1,0 +1,722 @@
+//! The implicit material point solver: load-step loop, Newton solve and commit (Figures 6–7).
+
+pub mod cell_fill;
+pub mod particles;
+
+use crate::basis::{Basis, BasisError, BasisFamily, PointSupport};
+use crate::discretise::assembly::{StartForces, StepInput, StepWorkspace, SupportTable};
+use crate::discretise::ghost::{node_share, GhostOperator, GhostSettings};
+use crate::material::constitutive::ConstitutiveModel;
+use crate::mesh::grid::Grid;
+use crate::mpm::particles::MaterialPoints;
+use crate::solver::dynamics::{BodyForce, Inertia, Newmark, NewmarkStep, TimeStep};
+use crate::solver::error::{require_count, FailedAttempt, InputError, StepFailure};
+use crate::solver::load_stepping::{Increment, LoadStepping};
+use crate::solver::newton::NewtonSettings;
+use cell_fill::cell_fill;
+use nalgebra::SVector;
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+pub use crate::basis::DomainUpdate;
+
+/// Solver settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MpmSettings {
+    pub basis: Basis,
+    pub domain_update: DomainUpdate,
+    pub newton: NewtonSettings,
+    /// Number of equal load increments.
+    pub load_steps: usize,
+    /// Weak nodes: a grid node whose share of material volume Σ_p S_vp V_p is below this
+    /// fraction of an element's volume (a domain grazing an element) makes the tangent nearly
+    /// singular and is treated by `weak_node_treatment` for the step. 0 disables.
+    #[serde(default)]
+    pub weak_node_tolerance: f64,
+    #[serde(default)]
+    pub weak_node_treatment: WeakNodeTreatment,
+    #[serde(default)]
+    pub volume_update: VolumeUpdate,
+    /// Sparse factorisation of the tangent: LU (default) or, for the symmetric tangents of
+    /// hyperelastic and associative plastic models, LDLᵀ/LLᵀ with LU as fallback.
+    #[serde(default)]
+    pub linear_solver: crate::solver::linear::LinearSolver,
+    /// Ghost penalty on the grid faces of nearly empty cells ([`crate::discretise::ghost`]); off by
+    /// default here, chosen per problem from measurements.
+    #[serde(default)]
+    pub ghost: GhostSettings,
+    /// Newmark time integration ([`crate::solver::dynamics`]): the load steps become time steps over
+    /// `duration`; `None` (default): quasi-static.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dynamics: Option<Newmark>,
+}
+
+/// The paper's method: iGIMP (eqs 7–10) with the stretch-tensor domain update (eq 39), the
+/// default Newton settings ([`NewtonSettings::default`]), 20 load steps (§5's examples), no
+/// weak-node treatment and no ghost penalty (both chosen per problem by measurement), the
+/// Jacobian volume update, the default direct solver, quasi-static.
+impl Default for MpmSettings {
+    fn default() -> Self {
+        MpmSettings {
+            basis: Basis::Gimp,
+            domain_update: DomainUpdate::Stretch,
+            newton: NewtonSettings::default(),
+            load_steps: 20,
+            weak_node_tolerance: 0.0,
+            weak_node_treatment: WeakNodeTreatment::default(),
+            volume_update: VolumeUpdate::default(),
+            linear_solver: crate::solver::linear::LinearSolver::default(),
+            ghost: GhostSettings::default(),
+            dynamics: None,
+        }
+    }
+}
+
+/// How the committed volume V_p^n of a material point is obtained (eq 28).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum VolumeUpdate {
+    /// V_p^n = det(F) v_p0, accumulated as det(ΔF) V_p^(n−1): conserves mass under any
+    /// deformation, and keeps the volume independent of the domain-update rule.
+    #[default]
+    Jacobian,
+    /// V_p^n = Π l_i, the product of the updated domain lengths, as §3.1 states. Equal to
+    /// the Jacobian in 1D; with the F-diagonal domain update it collapses under rotation,
+    /// which is how the paper's Figure 20(a) analysis fails.
+    DomainProduct,
+}
+
+/// How weak nodes are treated in a load step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum WeakNodeTreatment {
+    /// Tie the node to its strongest grid neighbour (same increment): moves the sliver of
+    /// material with its neighbour instead of pinning it. Falls back to `Fix` when no
+    /// neighbour has enough material.
+    #[default]
+    Tie,
+    /// Fix the node's increment at zero.
+    Fix,
+}
+
+impl MpmSettings {
+    pub fn validate(&self) -> Result<(), InputError> {
+        self.newton.validate()?;
+        self.ghost.validate()?;
+        if !(self.weak_node_tolerance >= 0.0 && self.weak_node_tolerance < 1.0) {
+            return Err(InputError::new(
+                "weak_node_tolerance",
+                self.weak_node_tolerance,
+                "must lie in [0, 1)",
+            ));
+        }
+        require_count("load_steps", self.load_steps, 1)?;
+        if let Some(n) = &self.dynamics {
+            n.validate()?;
+        }
+        if self.load_steps > MAX_LOAD_STEPS {
+            return Err(InputError::new(
+                "load_steps",
+                self.load_steps,
+                format!("must be <= {MAX_LOAD_STEPS}"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+pub use crate::solver::load_stepping::MAX_LOAD_STEPS;
+
+/// External loads at the end of the analysis, applied proportionally over the load steps.
+#[derive(Debug, Clone)]
+pub struct Loads<const D: usize> {
+    /// Gravitational acceleration (body force per unit mass).
+    pub gravity: SVector<f64, D>,
+    /// Point loads carried by material points: (point, force).
+    pub point_loads: Vec<(usize, SVector<f64, D>)>,
+}
+
+/// Implicit MPM / GIMP solver for `D` dimensions.
+pub struct MpmSolver<const D: usize> {
+    pub grid: Grid<D>,
+    pub points: MaterialPoints<D>,
+    model: Box<dyn ConstitutiveModel>,
+    /// Homogeneous Dirichlet conditions: (node, axis).
+    pub fixed: Vec<(usize, usize)>,
+    pub loads: Loads<D>,
+    pub settings: MpmSettings,
+    step: usize,
+    work: StepWorkspace<D>,
+    ghost: GhostOperator<D>,
+    /// The basis family: `settings.basis`'s, or one given by [`Self::with_family`].
+    family: Arc<dyn BasisFamily<D>>,
+    /// Nodal velocity, acceleration and predictor of the current dynamic step.
+    nodal: NodalMotion,
+    /// Time of the committed state (dynamic analyses).
+    time: f64,
+    /// A body force b₀(X, t) beside `loads` ([`Self::set_body_force`]).
+    body_force: Option<BodyForce<D>>,
+}
+
+/// The grid's motion at the start of a dynamic step, projected from the points, and the
+/// step's Newmark predictor ã (a₁ = Δu/(βΔt²) − ã), per nodal dof.
+#[derive(Debug, Default)]
+struct NodalMotion {
+    velocity: Vec<f64>,
+    acceleration: Vec<f64>,
+    predictor: Vec<f64>,
+}
+
+impl<const D: usize> MpmSolver<D> {
+    pub fn try_new(
+        grid: Grid<D>,
+        points: MaterialPoints<D>,
+        model: Box<dyn ConstitutiveModel>,
+        fixed: Vec<(usize, usize)>,
+        loads: Loads<D>,
+        settings: MpmSettings,
+    ) -> Result<Self, InputError> {
+        settings.validate()?;
+        if points.is_empty() {
+            return Err(InputError::new(
+                "material points",
+                0,
+                "at least one point is required",
+            ));
+        }
+        for p in 0..points.len() {
+            if !grid.contains_box(&points.position[p], &points.half_length[p]) {
+                return Err(InputError::new(
+                    format!("material point {p}"),
+                    format!("{:?}", points.position[p].as_slice()),
+                    "point and its domain must lie inside the background grid",
+                ));
+            }
+        }
+        for &(n, a) in &fixed {
+            if n >= grid.num_nodes() || a >= D {
+                return Err(InputError::new(
+                    "fixed dof",
+                    format!("(node {n}, axis {a})"),
+                    format!("node < {} and axis < {D}", grid.num_nodes()),
+                ));
+            }
+        }
+        for a in 0..D {
+            crate::solver::error::require_finite(&format!("gravity[{a}]"), loads.gravity[a])?;
+        }
+        for (p, f) in &loads.point_loads {
+            if *p >= points.len() || f.iter().any(|v| !v.is_finite()) {
+                return Err(InputError::new(
+                    "point load",
+                    format!("(point {p}, {:?})", f.as_slice()),
+                    format!("point < {} and finite force", points.len()),
+                ));
+            }
+        }
+        let family = settings.basis.shared::<D>();
+        let mut points = points;
+        if family.needs_corners() {
+            points.track_corners();
+        }
+        Ok(Self {
+            grid,
+            points,
+            model,
+            fixed,
+            loads,
+            settings,
+            step: 0,
+            work: StepWorkspace::default(),
+            ghost: GhostOperator::default(),
+            family,
+            nodal: NodalMotion::default(),
+            time: 0.0,
+            body_force: None,
+        })
+    }
+
+    /// Renumber the material points cell by cell ([`MaterialPoints::sort_by_cell`]) and the
+    /// point loads with them, between steps. The assembly then adds a cell's points as one
+    /// run; results change at round-off only (sums over points in another order). Returns
+    /// the permutation: new point `k` is old point `order[k]`.
+    pub fn sort_points_by_cell(&mut self) -> Vec<usize> {
+        let order = self.points.sort_by_cell(&self.grid);
+        let mut new_index = vec![0; order.len()];
+        for (k, &p) in order.iter().enumerate() {
+            new_index[p] = k;
+        }
+        for (p, _) in self.loads.point_loads.iter_mut() {
+            *p = new_index[*p];
+        }
+        order
+    }
+
+    /// Load the points with a body force per unit reference volume b₀(X, t) besides `loads`:
+    /// b₀(X_p, t) V_p0 on each point, t the end time of each step (the load factor in a
+    /// quasi-static analysis).
+    pub fn set_body_force(&mut self, body_force: BodyForce<D>) {
+        self.body_force = Some(body_force);
+    }
+
+    /// The solver with a basis family of the caller's instead of `settings.basis`'s (e.g. one
+    /// defined outside this crate against [`BasisFamily`]; `examples/custom_basis.rs`).
+    /// `settings.basis` then only names the run.
+    pub fn with_family(mut self, family: Arc<dyn BasisFamily<D>>) -> Self {
+        if family.needs_corners() {
+            self.points.track_corners();
+        }
+        self.family = family;
+        self
+    }
+
+    /// The constitutive model.
+    pub fn model(&self) -> &dyn ConstitutiveModel {
+        self.model.as_ref()
+    }
+
+    /// The failure of a point whose weights cannot be formed at (x, h).
+    fn basis_failure(p: usize, x: &SVector<f64, D>, h: &SVector<f64, D>, e: BasisError) -> StepFailure {
+        match e {
+            BasisError::DegenerateDomain { .. } | BasisError::InvertedDomain => StepFailure::Kinematics {
+                point: p,
+                reason: format!("{e} (half-lengths {:?})", h.as_slice()),
+            },
+            _ => StepFailure::LeftGrid {
+                point: p,
+                position: format!("{:?}: {e}", x.as_slice()),
+            },
+        }
+    }
+
+    /// Evaluate the weights of every point on the grid at the current positions and domains.
+    pub fn build_supports(&mut self) -> Result<(), StepFailure> {
+        crate::solver::profile::timed(crate::solver::profile::Phase::Weights, || {
+            self.build_supports_untimed()
+        })
+    }
+
+    /// The solver's basis family (shared, so that it can be used while the solver's fields are
+    /// borrowed mutably).
+    fn family(&self) -> Arc<dyn BasisFamily<D>> {
+        Arc::clone(&self.family)
+    }
+
+    fn build_supports_untimed(&mut self) -> Result<(), StepFailure> {
+        let family = self.family();
+        self.work.table.clear();
+        let mut sup = PointSupport::<D>::default();
+        for p in 0..self.points.len() {
+            family
+                .evaluate(&self.grid, &self.points.view(p), &mut sup)
+                .map_err(|e| {
+                    Self::basis_failure(p, &self.points.position[p], &self.points.half_length[p], e)
+                })?;
+            for k in 0..sup.len() {
+                let (node, s, g) = sup.node(k);
+                self.work.table.push_node(node, s, g);
+            }
+            self.work.table.finish_point();
+        }
+        Ok(())
+    }
+
+    /// What the linear solves have cost so far (solves, Krylov iterations, seconds) and how
+    /// many fell back to another solver.
+    pub fn linear_stats(&self) -> (crate::solver::linear::LinearStats, usize) {
+        (self.work.matrix.stats(), self.work.matrix.fallbacks())
+    }
+
+    /// Unknowns and non-zeros of the last tangent.
+    pub fn system_size(&self) -> (usize, usize) {
+        (self.work.matrix.dim(), self.work.matrix.nnz())
+    }
+
+    /// Nodal displacement increment Δu of the last converged load step (node-major:
+    /// `node * D + axis`; empty before the first step). The grid is reset every step, so this
+    /// is the only nodal displacement the solver has.
+    pub fn step_increment(&self) -> &[f64] {
+        &self.work.du_nodal
+    }
+
+    /// The ghost operator of the last increment (faces, cell fill fractions).
+    pub fn ghost(&self) -> &GhostOperator<D> {
+        &self.ghost
+    }
+
+    /// Form the ghost operator for the current configuration (after [`Self::build_supports`]).
+    pub fn build_ghost(&mut self) {
+        let start = std::time::Instant::now();
+        if self.settings.ghost.is_on() {
+            cell_fill(&self.grid, &*self.family, &self.points, self.ghost.fill_mut());
+        }
+        if self.settings.ghost.is_on() && self.settings.ghost.cut_share > 0.0 {
+            node_share(
+                &self.grid,
+                &self.work.table,
+                self.points.state.iter().map(|s| s.volume),
+                self.ghost.share_mut(),
+            );
+        }
+        self.ghost
+            .build(&self.grid, &self.settings.ghost, self.model.young_modulus());
+        self.ghost.retain_reached(&self.work.table);
+        crate::solver::profile::charge(crate::solver::profile::Phase::Weights, start);
+    }
+
+    /// Supports of the last [`Self::build_supports`].
+    pub fn supports(&self) -> &SupportTable<D> {
+        &self.work.table
+    }
+
+    /// Nodes whose material volume share Σ_p S_vp V_p^n is positive but below
+    /// `weak_node_tolerance` × element volume, from the current supports, and the
+    /// (slave, master) ties chosen for them under [`WeakNodeTreatment::Tie`].
+    pub fn weak_nodes(&self) -> (Vec<usize>, Vec<(usize, usize)>) {
+        let tol = self.settings.weak_node_tolerance;
+        if tol <= 0.0 {
+            return (vec![], vec![]);
+        }
+        let cell: f64 = self.grid.spacing().iter().product();
+        let mut share = vec![0.0; self.grid.num_nodes()];
+        let mut touched = vec![false; self.grid.num_nodes()];
+        let table = &self.work.table;
+        for p in 0..table.num_points() {
+            let (nodes, s, _) = table.point(p);
+            for (&n, &w) in nodes.iter().zip(s) {
+                share[n] += w * self.points.state[p].volume;
+                touched[n] = true;
+            }
+        }
+        let threshold = tol * cell;
+        let weak: Vec<usize> = (0..share.len())
+            .filter(|&n| touched[n] && share[n] < threshold)
+            .collect();
+        let mut ties = Vec::new();
+        if self.settings.weak_node_treatment == WeakNodeTreatment::Tie {
+            for &n in &weak {
+                let idx = self.grid.node_coords(n);
+                let mut best: Option<(usize, f64)> = None;
+                for a in 0..D {
+                    for up in [false, true] {
+                        let mut j = idx;
+                        if up {
+                            if j[a] + 1 >= self.grid.nodes_along(a) {
+                                continue;
+                            }
+                            j[a] += 1;
+                        } else {
+                            if j[a] == 0 {
+                                continue;
+                            }
+                            j[a] -= 1;
+                        }
+                        let m = self.grid.node_index(j);
+                        if share[m] >= threshold && best.is_none_or(|(_, s)| share[m] > s) {
+                            best = Some((m, share[m]));
+                        }
+                    }
+                }
+                if let Some((m, _)) = best {
+                    ties.push((n, m));
+                }
+            }
+        }
+        (weak, ties)
+    }
+
+    fn external_point_forces(&self, load_factor: f64) -> Vec<SVector<f64, D>> {
+        let mut forces: Vec<SVector<f64, D>> = self
+            .points
+            .mass
+            .iter()
+            .map(|&m| self.loads.gravity * (m * load_factor))
+            .collect();
+        for (p, f) in &self.loads.point_loads {
+            forces[*p] += f * load_factor;
+        }
+        forces
+    }
+
+    /// Domain half-lengths after committing F (eqs 37/39).
+    fn updated_half_length(&self, p: usize, f: &nalgebra::Matrix3<f64>) -> SVector<f64, D> {
+        self.settings
+            .domain_update
+            .half_length(&self.points.half_length0[p], f)
+    }
+
+    /// Commit the converged step: states, positions (x += Σ S Δu) and domains (eqs 37/39).
+    /// A domain that would collapse (length ≤ 0) fails the increment before anything is
+    /// committed, so that the load stepping can retry it with a smaller one.
+    fn commit(&mut self, newmark: Option<NewmarkStep>) -> Result<(), StepFailure> {
+        let family = self.family();
+        let mut probe = PointSupport::<D>::default();
+        let corners_per_point = if family.needs_corners() { 1 << D } else { 0 };
+        let mut corners = [SVector::<f64, D>::zeros(); crate::basis::cpdi::MAX_CORNERS];
+        for p in 0..self.points.len() {
+            let trial = self.work.trials[p].as_ref().expect("converged trial");
+            let f = trial.f(&self.points.state[p]);
+            let h = self.updated_half_length(p, &f);
+            if let Some(a) = (0..D).find(|&a| !(h[a] > 0.0 && h[a].is_finite())) {
+                return Err(StepFailure::Kinematics {
+                    point: p,
+                    reason: format!(
+                        "domain collapsed along axis {a} (updated half-length {:.3e})",
+                        h[a]
+                    ),
+                });
+            }
+            // Weights the next step could not form (a point leaving the grid, a domain longer
+            // than the basis allows, a folded CPDI domain) are caught here, before anything is
+            // committed, so that the increment can be cut; found at the next step's weights
+            // they would fail every retry from the already committed state.
+            let x = self.points.position[p] + self.work.table.interpolate(p, &self.work.du_nodal);
+            let c = &mut corners[..corners_per_point];
+            c.copy_from_slice(self.points.corners_of(p));
+            family
+                .update_corners(&self.grid, &self.work.du_nodal, c)
+                .map_err(|e| Self::basis_failure(p, &x, &h, e))?;
+            let view = crate::basis::PointView {
+                position: &x,
+                half_length: &h,
+                position0: &self.points.position0[p],
+                half_length0: &self.points.half_length0[p],
+                f: &f,
+                corners: c,
+            };
+            family
+                .evaluate(&self.grid, &view, &mut probe)
+                .map_err(|e| Self::basis_failure(p, &x, &h, e))?;
+        }
+        if let Some(n) = newmark {
+            self.commit_motion(&n);
+        }
+        for p in 0..self.points.len() {
+            let trial = self.work.trials[p].as_ref().expect("converged trial");
+            let new_state = trial.committed(&self.points.state[p]);
+            self.points.state[p] = new_state;
+            let du = self.work.table.interpolate(p, &self.work.du_nodal);
+            self.points.position[p] += du;
+            self.points.half_length[p] = self.updated_half_length(p, &new_state.f);
+            if corners_per_point > 0 {
+                let c = &mut self.points.corners[p * corners_per_point..(p + 1) * corners_per_point];
+                family
+                    .update_corners(&self.grid, &self.work.du_nodal, c)
+                    .expect("corner update checked above");
+            }
+            if self.settings.volume_update == VolumeUpdate::DomainProduct {
+                // The paper's V_p^n: the product of the domain lengths (unit out-of-plane).
+                let h = self.points.half_length[p];
+                self.points.state[p].volume = (0..D).map(|a| 2.0 * h[a]).product();
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<const D: usize> MpmSolver<D> {
+    /// Time of the committed state (0 for quasi-static analyses).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// The grid's v₀, a₀ of a dynamic step from the points (mass-weighted, zero at the fixed
+    /// dofs) and the step's predictor ã, after the step's supports are built.
+    fn project_motion(&mut self, n: &NewmarkStep, fixed: &[(usize, usize)]) {
+        let dofs = self.grid.num_nodes() * D;
+        let m = &mut self.nodal;
+        for v in [&mut m.velocity, &mut m.acceleration, &mut m.predictor] {
+            v.clear();
+            v.resize(dofs, 0.0);
+        }
+        let mut mass = vec![0.0; self.grid.num_nodes()];
+        let table = &self.work.table;
+        for p in 0..table.num_points() {
+            let (nodes, s, _) = table.point(p);
+            let mp = self.points.mass[p];
+            for (&node, &w) in nodes.iter().zip(s) {
+                mass[node] += w * mp;
+                for a in 0..D {
+                    m.velocity[node * D + a] += w * mp * self.points.velocity[p][a];
+                    m.acceleration[node * D + a] += w * mp * self.points.acceleration[p][a];
+                }
+            }
+        }
+        for (node, &mn) in mass.iter().enumerate() {
+            if mn > 0.0 {
+                for a in 0..D {
+                    m.velocity[node * D + a] /= mn;
+                    m.acceleration[node * D + a] /= mn;
+                }
+            }
+        }
+        for &(node, a) in fixed {
+            m.velocity[node * D + a] = 0.0;
+            m.acceleration[node * D + a] = 0.0;
+        }
+        for k in 0..dofs {
+            m.predictor[k] = n.predictor(m.velocity[k], m.acceleration[k]);
+        }
+    }
+
+    /// The points' velocities and accelerations after a converged dynamic step:
+    /// v_p += Σ_a S_ap Δt((1 − γ) a₀ + γ a₁)_a, a_p = Σ_a S_ap a₁_a ([`crate::solver::dynamics`]).
+    fn commit_motion(&mut self, n: &NewmarkStep) {
+        let table = &self.work.table;
+        let (du, m) = (&self.work.du_nodal, &self.nodal);
+        for p in 0..table.num_points() {
+            let (nodes, s, _) = table.point(p);
+            let (mut dv, mut a1) = (SVector::<f64, D>::zeros(), SVector::<f64, D>::zeros());
+            for (&node, &w) in nodes.iter().zip(s) {
+                for a in 0..D {
+                    let k = node * D + a;
+                    let acc = n.acceleration_after(du[k], m.predictor[k]);
+                    a1[a] += w * acc;
+                    dv[a] += w * n.velocity_change(m.acceleration[k], acc);
+                }
+            }
+            self.points.velocity[p] += dv;
+            self.points.acceleration[p] = a1;
+        }
+    }
+}
+
+/// The [`StepInput`] of a prepared step; a macro so that it borrows the solver's fields, not
+/// the whole solver (the workspace is borrowed mutably beside it).
+macro_rules! step_input {
+    ($solver:ident, $step:ident) => {
+        StepInput {
+            model: $solver.model.as_ref(),
+            states: &$solver.points.state,
+            num_nodes: $solver.grid.num_nodes(),
+            fixed: &$step.fixed,
+            ties: &$step.ties,
+            point_forces: &$step.forces,
+            nodal_forces: &[],
+            ghost: $solver.settings.ghost.is_on().then_some(&$solver.ghost),
+            inertia: $step.time_step.map(|t| Inertia {
+                step: t.newmark,
+                predictor: &$solver.nodal.predictor,
+                acceleration: &$solver.nodal.acceleration,
+                mass: $solver.settings.dynamics.map(|d| d.mass).unwrap_or_default(),
+                point_masses: &$solver.points.mass,
+            }),
+            start_forces: $step.start_forces.as_deref().map(|f| StartForces {
+                point_forces: f,
+                nodal_forces: &[],
+            }),
+        }
+    };
+}
+
+/// What one load step of the material point solver assembles from: the point forces at its
+/// load factor and the constraints of its weak nodes.
+struct PreparedStep<const D: usize> {
+    forces: Vec<SVector<f64, D>>,
+    fixed: Vec<(usize, usize)>,
+    ties: Vec<(usize, usize)>,
+    weak_nodes: usize,
+    /// The time step of a dynamic analysis.
+    time_step: Option<TimeStep>,
+    /// Generalised-α: the point forces at the step's start.
+    start_forces: Option<Vec<SVector<f64, D>>>,
+}
+
+impl<const D: usize> MpmSolver<D> {
+    /// Weights, ghost term, forces and constraints of a step at `load_factor` (of a dynamic
+    /// analysis: to time `load_factor` × duration, the forces at that time, the grid's motion
+    /// projected and the Newmark predictor formed).
+    fn prepare_step(&mut self, load_factor: f64) -> Result<PreparedStep<D>, StepFailure> {
+        self.build_supports()?;
+        self.build_ghost();
+        let time_step = self.settings.dynamics.map(|d| d.step_to(self.time, load_factor));
+        let mut forces = self.external_point_forces(time_step.map_or(load_factor, |t| t.load_factor));
+        if let Some(b) = &self.body_force {
+            let t = time_step.map_or(load_factor, |t| t.end);
+            b.add_to(&self.points.position0, &self.points.volume0, t, &mut forces)?;
+        }
+        let start_forces = match (self.settings.dynamics, &time_step) {
+            (Some(d), Some(t)) if !t.newmark.is_newmark() => {
+                let mut f = self.external_point_forces(d.load.factor(self.time));
+                if let Some(b) = &self.body_force {
+                    b.add_to(&self.points.position0, &self.points.volume0, self.time, &mut f)?;
+                }
+                Some(f)
+            }
+            _ => None,
+        };
+        let (weak, ties) = self.weak_nodes();
+        let mut fixed = self.fixed.clone();
+        let tied: Vec<usize> = ties.iter().map(|t| t.0).collect();
+        fixed.extend(
+            weak.iter()
+                .filter(|n| !tied.contains(n))
+                .flat_map(|&n| (0..D).map(move |a| (n, a))),
+        );
+        if let Some(t) = &time_step {
+            self.project_motion(&t.newmark, &fixed);
+        }
+        Ok(PreparedStep {
+            forces,
+            fixed,
+            ties,
+            weak_nodes: weak.len(),
+            time_step,
+            start_forces,
+        })
+    }
+
+    /// The nonlinear system of the next load step at `load_factor` (unknowns: the nodal
+    /// displacement increment from the committed state), for evaluations outside Newton, e.g.
+    /// the residual of a prescribed field. Nothing is committed.
+    pub fn with_step_system<R>(
+        &mut self,
+        load_factor: f64,
+        f: impl FnOnce(&mut crate::discretise::assembly::LoadStepSystem<'_, D>) -> R,
+    ) -> Result<R, StepFailure> {
+        let step = self.prepare_step(load_factor)?;
+        let input = step_input!(self, step);
+        Ok(self.work.with_system(&input, f))
+    }
+}
+
+impl<const D: usize> LoadStepping for MpmSolver<D> {
+    fn advance(&mut self, load_factor: f64) -> Result<Increment, FailedAttempt> {
+        let step = self.prepare_step(load_factor).map_err(FailedAttempt::from)?;
+        if self.settings.linear_solver == crate::solver::linear::LinearSolver::Iterative
+            && self.work.node_geometry.is_none()
+        {
+            self.work.node_geometry = Some(crate::solver::multigrid::NodeGeometry::of_grid(&self.grid));
+        }
+        let input = step_input!(self, step);
+        self.work.matrix.set_solver(self.settings.linear_solver);
+        let before = self.work.matrix.stats().iterations;
+        let report = self.work.solve(&input, &self.settings.newton)?;
+        let linear = self.work.linear_record(before);
+        self.commit(step.time_step.map(|t| t.newmark))
+            .map_err(|failure| FailedAttempt {
+                failure,
+                residuals: report.residuals.clone(),
+            })?;
+        if let Some(t) = step.time_step {
+            self.time = t.end;
+        }
+        Ok(Increment {
+            newton: report,
+            weak_nodes: step.weak_nodes,
+            linear,
+        })
+    }
+    fn steps_done(&self) -> usize {
+        self.step
+    }
+    fn set_steps_done(&mut self, n: usize) {
+        self.step = n;
+    }
+    fn load_steps(&self) -> usize {
+        self.settings.load_steps
+    }
+    fn newton_settings(&self) -> &NewtonSettings {
+        &self.settings.newton
+    }
+}
