@@ -46,7 +46,7 @@ pub fn column_errors(elements: &[usize]) -> (Vec<(usize, f64)>, f64) {
             .mpm_solver(Basis::Mpm)
             .expect("a valid column")
             .with_family(family.clone());
-        if let Err((_, failure)) = solver.run() {
+        if let Err(failure) = solver.run() {
             panic!("{n} elements: {failure}");
         }
         let exact = spec.analytical();

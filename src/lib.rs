@@ -54,12 +54,14 @@
 //! let elements = 50;
 //! let grid = Grid::try_new([0.0], [length / elements as f64], [elements])?;
 //! let points = MaterialPoints::fill_box(&grid, [0.0], [length], [2], density)?;
-//! let model = Box::new(LinearElastic::try_new(young, 0.0)?);
 //! let gravity = weight / (density * length);
-//! let loads = Loads { gravity: SVector::<f64, 1>::new(-gravity), point_loads: vec![] };
-//! // Node 0 (the base) fixed along axis 0; iGIMP, 20 load steps: the defaults.
-//! let mut solver = MpmSolver::try_new(grid, points, model, vec![(0, 0)], loads, MpmSettings::default())?;
-//! solver.run().map_err(|(_, e)| e)?;
+//! // The base (node 0) fixed along axis 0; iGIMP and 20 load steps are the defaults.
+//! let mut solver = MpmSolver::builder(grid, points)
+//!     .material(LinearElastic::try_new(young, 0.0)?)
+//!     .fix(0, 0)
+//!     .gravity(SVector::<f64, 1>::new(-gravity))
+//!     .build()?;
+//! solver.run()?;
 //!
 //! let exact = AnalyticalColumn {
 //!     lambda: 0.0,
@@ -155,10 +157,10 @@ pub mod prelude {
     pub use crate::material::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
     pub use crate::mesh::grid::Grid;
     pub use crate::mpm::particles::MaterialPoints;
-    pub use crate::mpm::{DomainUpdate, Loads, MpmSettings, MpmSolver};
+    pub use crate::mpm::{DomainUpdate, Loads, MpmBuilder, MpmSettings, MpmSolver};
     pub use crate::problems::column::AnalyticalColumn;
     pub use crate::solver::error::{InputError, SolveError};
-    pub use crate::solver::load_stepping::LoadStepping;
+    pub use crate::solver::load_stepping::{LoadStepping, RunFailure};
     pub use crate::solver::newton::NewtonSettings;
     pub use nalgebra::SVector;
 }

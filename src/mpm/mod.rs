@@ -1,131 +1,29 @@
 //! The implicit material point solver: load-step loop, Newton solve and commit (Figures 6–7).
 
+mod builder;
 pub mod cell_fill;
+mod motion;
 pub mod particles;
+mod settings;
+mod step;
 
-use crate::basis::{Basis, BasisError, BasisFamily, PointSupport};
-use crate::discretise::assembly::{StartForces, StepInput, StepWorkspace, SupportTable};
-use crate::discretise::ghost::{node_share, GhostOperator, GhostSettings};
+use crate::basis::{BasisError, BasisFamily, PointSupport};
+use crate::discretise::assembly::{StepWorkspace, SupportTable};
+use crate::discretise::ghost::{node_share, GhostOperator};
 use crate::material::constitutive::ConstitutiveModel;
 use crate::mesh::grid::Grid;
 use crate::mpm::particles::MaterialPoints;
-use crate::solver::dynamics::{BodyForce, Inertia, Newmark, NewmarkStep, TimeStep};
-use crate::solver::error::{require_count, FailedAttempt, InputError, StepFailure};
-use crate::solver::load_stepping::{Increment, LoadStepping};
-use crate::solver::newton::NewtonSettings;
+use crate::solver::dynamics::{BodyForce, NewmarkStep};
+use crate::solver::error::{InputError, StepFailure};
 use cell_fill::cell_fill;
 use nalgebra::SVector;
-use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
 pub use crate::basis::DomainUpdate;
 
-/// Solver settings.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct MpmSettings {
-    pub basis: Basis,
-    pub domain_update: DomainUpdate,
-    pub newton: NewtonSettings,
-    /// Number of equal load increments.
-    pub load_steps: usize,
-    /// Weak nodes: a grid node whose share of material volume Σ_p S_vp V_p is below this
-    /// fraction of an element's volume (a domain grazing an element) makes the tangent nearly
-    /// singular and is treated by `weak_node_treatment` for the step. 0 disables.
-    #[serde(default)]
-    pub weak_node_tolerance: f64,
-    #[serde(default)]
-    pub weak_node_treatment: WeakNodeTreatment,
-    #[serde(default)]
-    pub volume_update: VolumeUpdate,
-    /// Sparse factorisation of the tangent: LU (default) or, for the symmetric tangents of
-    /// hyperelastic and associative plastic models, LDLᵀ/LLᵀ with LU as fallback.
-    #[serde(default)]
-    pub linear_solver: crate::solver::linear::LinearSolver,
-    /// Ghost penalty on the grid faces of nearly empty cells ([`crate::discretise::ghost`]); off by
-    /// default here, chosen per problem from measurements.
-    #[serde(default)]
-    pub ghost: GhostSettings,
-    /// Newmark time integration ([`crate::solver::dynamics`]): the load steps become time steps over
-    /// `duration`; `None` (default): quasi-static.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub dynamics: Option<Newmark>,
-}
-
-/// The paper's method: iGIMP (eqs 7–10) with the stretch-tensor domain update (eq 39), the
-/// default Newton settings ([`NewtonSettings::default`]), 20 load steps (§5's examples), no
-/// weak-node treatment and no ghost penalty (both chosen per problem by measurement), the
-/// Jacobian volume update, the default direct solver, quasi-static.
-impl Default for MpmSettings {
-    fn default() -> Self {
-        MpmSettings {
-            basis: Basis::Gimp,
-            domain_update: DomainUpdate::Stretch,
-            newton: NewtonSettings::default(),
-            load_steps: 20,
-            weak_node_tolerance: 0.0,
-            weak_node_treatment: WeakNodeTreatment::default(),
-            volume_update: VolumeUpdate::default(),
-            linear_solver: crate::solver::linear::LinearSolver::default(),
-            ghost: GhostSettings::default(),
-            dynamics: None,
-        }
-    }
-}
-
-/// How the committed volume V_p^n of a material point is obtained (eq 28).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum VolumeUpdate {
-    /// V_p^n = det(F) v_p0, accumulated as det(ΔF) V_p^(n−1): conserves mass under any
-    /// deformation, and keeps the volume independent of the domain-update rule.
-    #[default]
-    Jacobian,
-    /// V_p^n = Π l_i, the product of the updated domain lengths, as §3.1 states. Equal to
-    /// the Jacobian in 1D; with the F-diagonal domain update it collapses under rotation,
-    /// which is how the paper's Figure 20(a) analysis fails.
-    DomainProduct,
-}
-
-/// How weak nodes are treated in a load step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum WeakNodeTreatment {
-    /// Tie the node to its strongest grid neighbour (same increment): moves the sliver of
-    /// material with its neighbour instead of pinning it. Falls back to `Fix` when no
-    /// neighbour has enough material.
-    #[default]
-    Tie,
-    /// Fix the node's increment at zero.
-    Fix,
-}
-
-impl MpmSettings {
-    pub fn validate(&self) -> Result<(), InputError> {
-        self.newton.validate()?;
-        self.ghost.validate()?;
-        if !(self.weak_node_tolerance >= 0.0 && self.weak_node_tolerance < 1.0) {
-            return Err(InputError::new(
-                "weak_node_tolerance",
-                self.weak_node_tolerance,
-                "must lie in [0, 1)",
-            ));
-        }
-        require_count("load_steps", self.load_steps, 1)?;
-        if let Some(n) = &self.dynamics {
-            n.validate()?;
-        }
-        if self.load_steps > MAX_LOAD_STEPS {
-            return Err(InputError::new(
-                "load_steps",
-                self.load_steps,
-                format!("must be <= {MAX_LOAD_STEPS}"),
-            ));
-        }
-        Ok(())
-    }
-}
-
 pub use crate::solver::load_stepping::MAX_LOAD_STEPS;
+pub use builder::MpmBuilder;
+pub use settings::{MpmSettings, VolumeUpdate, WeakNodeTreatment};
 
 /// External loads at the end of the analysis, applied proportionally over the load steps.
 #[derive(Debug, Clone)]
@@ -511,212 +409,5 @@ impl<const D: usize> MpmSolver<D> {
             }
         }
         Ok(())
-    }
-}
-
-impl<const D: usize> MpmSolver<D> {
-    /// Time of the committed state (0 for quasi-static analyses).
-    pub fn time(&self) -> f64 {
-        self.time
-    }
-
-    /// The grid's v₀, a₀ of a dynamic step from the points (mass-weighted, zero at the fixed
-    /// dofs) and the step's predictor ã, after the step's supports are built.
-    fn project_motion(&mut self, n: &NewmarkStep, fixed: &[(usize, usize)]) {
-        let dofs = self.grid.num_nodes() * D;
-        let m = &mut self.nodal;
-        for v in [&mut m.velocity, &mut m.acceleration, &mut m.predictor] {
-            v.clear();
-            v.resize(dofs, 0.0);
-        }
-        let mut mass = vec![0.0; self.grid.num_nodes()];
-        let table = &self.work.table;
-        for p in 0..table.num_points() {
-            let (nodes, s, _) = table.point(p);
-            let mp = self.points.mass[p];
-            for (&node, &w) in nodes.iter().zip(s) {
-                mass[node] += w * mp;
-                for a in 0..D {
-                    m.velocity[node * D + a] += w * mp * self.points.velocity[p][a];
-                    m.acceleration[node * D + a] += w * mp * self.points.acceleration[p][a];
-                }
-            }
-        }
-        for (node, &mn) in mass.iter().enumerate() {
-            if mn > 0.0 {
-                for a in 0..D {
-                    m.velocity[node * D + a] /= mn;
-                    m.acceleration[node * D + a] /= mn;
-                }
-            }
-        }
-        for &(node, a) in fixed {
-            m.velocity[node * D + a] = 0.0;
-            m.acceleration[node * D + a] = 0.0;
-        }
-        for k in 0..dofs {
-            m.predictor[k] = n.predictor(m.velocity[k], m.acceleration[k]);
-        }
-    }
-
-    /// The points' velocities and accelerations after a converged dynamic step:
-    /// v_p += Σ_a S_ap Δt((1 − γ) a₀ + γ a₁)_a, a_p = Σ_a S_ap a₁_a ([`crate::solver::dynamics`]).
-    fn commit_motion(&mut self, n: &NewmarkStep) {
-        let table = &self.work.table;
-        let (du, m) = (&self.work.du_nodal, &self.nodal);
-        for p in 0..table.num_points() {
-            let (nodes, s, _) = table.point(p);
-            let (mut dv, mut a1) = (SVector::<f64, D>::zeros(), SVector::<f64, D>::zeros());
-            for (&node, &w) in nodes.iter().zip(s) {
-                for a in 0..D {
-                    let k = node * D + a;
-                    let acc = n.acceleration_after(du[k], m.predictor[k]);
-                    a1[a] += w * acc;
-                    dv[a] += w * n.velocity_change(m.acceleration[k], acc);
-                }
-            }
-            self.points.velocity[p] += dv;
-            self.points.acceleration[p] = a1;
-        }
-    }
-}
-
-/// The [`StepInput`] of a prepared step; a macro so that it borrows the solver's fields, not
-/// the whole solver (the workspace is borrowed mutably beside it).
-macro_rules! step_input {
-    ($solver:ident, $step:ident) => {
-        StepInput {
-            model: $solver.model.as_ref(),
-            states: &$solver.points.state,
-            num_nodes: $solver.grid.num_nodes(),
-            fixed: &$step.fixed,
-            ties: &$step.ties,
-            point_forces: &$step.forces,
-            nodal_forces: &[],
-            ghost: $solver.settings.ghost.is_on().then_some(&$solver.ghost),
-            inertia: $step.time_step.map(|t| Inertia {
-                step: t.newmark,
-                predictor: &$solver.nodal.predictor,
-                acceleration: &$solver.nodal.acceleration,
-                mass: $solver.settings.dynamics.map(|d| d.mass).unwrap_or_default(),
-                point_masses: &$solver.points.mass,
-            }),
-            start_forces: $step.start_forces.as_deref().map(|f| StartForces {
-                point_forces: f,
-                nodal_forces: &[],
-            }),
-        }
-    };
-}
-
-/// What one load step of the material point solver assembles from: the point forces at its
-/// load factor and the constraints of its weak nodes.
-struct PreparedStep<const D: usize> {
-    forces: Vec<SVector<f64, D>>,
-    fixed: Vec<(usize, usize)>,
-    ties: Vec<(usize, usize)>,
-    weak_nodes: usize,
-    /// The time step of a dynamic analysis.
-    time_step: Option<TimeStep>,
-    /// Generalised-α: the point forces at the step's start.
-    start_forces: Option<Vec<SVector<f64, D>>>,
-}
-
-impl<const D: usize> MpmSolver<D> {
-    /// Weights, ghost term, forces and constraints of a step at `load_factor` (of a dynamic
-    /// analysis: to time `load_factor` × duration, the forces at that time, the grid's motion
-    /// projected and the Newmark predictor formed).
-    fn prepare_step(&mut self, load_factor: f64) -> Result<PreparedStep<D>, StepFailure> {
-        self.build_supports()?;
-        self.build_ghost();
-        let time_step = self.settings.dynamics.map(|d| d.step_to(self.time, load_factor));
-        let mut forces = self.external_point_forces(time_step.map_or(load_factor, |t| t.load_factor));
-        if let Some(b) = &self.body_force {
-            let t = time_step.map_or(load_factor, |t| t.end);
-            b.add_to(&self.points.position0, &self.points.volume0, t, &mut forces)?;
-        }
-        let start_forces = match (self.settings.dynamics, &time_step) {
-            (Some(d), Some(t)) if !t.newmark.is_newmark() => {
-                let mut f = self.external_point_forces(d.load.factor(self.time));
-                if let Some(b) = &self.body_force {
-                    b.add_to(&self.points.position0, &self.points.volume0, self.time, &mut f)?;
-                }
-                Some(f)
-            }
-            _ => None,
-        };
-        let (weak, ties) = self.weak_nodes();
-        let mut fixed = self.fixed.clone();
-        let tied: Vec<usize> = ties.iter().map(|t| t.0).collect();
-        fixed.extend(
-            weak.iter()
-                .filter(|n| !tied.contains(n))
-                .flat_map(|&n| (0..D).map(move |a| (n, a))),
-        );
-        if let Some(t) = &time_step {
-            self.project_motion(&t.newmark, &fixed);
-        }
-        Ok(PreparedStep {
-            forces,
-            fixed,
-            ties,
-            weak_nodes: weak.len(),
-            time_step,
-            start_forces,
-        })
-    }
-
-    /// The nonlinear system of the next load step at `load_factor` (unknowns: the nodal
-    /// displacement increment from the committed state), for evaluations outside Newton, e.g.
-    /// the residual of a prescribed field. Nothing is committed.
-    pub fn with_step_system<R>(
-        &mut self,
-        load_factor: f64,
-        f: impl FnOnce(&mut crate::discretise::assembly::LoadStepSystem<'_, D>) -> R,
-    ) -> Result<R, StepFailure> {
-        let step = self.prepare_step(load_factor)?;
-        let input = step_input!(self, step);
-        Ok(self.work.with_system(&input, f))
-    }
-}
-
-impl<const D: usize> LoadStepping for MpmSolver<D> {
-    fn advance(&mut self, load_factor: f64) -> Result<Increment, FailedAttempt> {
-        let step = self.prepare_step(load_factor).map_err(FailedAttempt::from)?;
-        if self.settings.linear_solver == crate::solver::linear::LinearSolver::Iterative
-            && self.work.node_geometry.is_none()
-        {
-            self.work.node_geometry = Some(crate::solver::multigrid::NodeGeometry::of_grid(&self.grid));
-        }
-        let input = step_input!(self, step);
-        self.work.matrix.set_solver(self.settings.linear_solver);
-        let before = self.work.matrix.stats().iterations;
-        let report = self.work.solve(&input, &self.settings.newton)?;
-        let linear = self.work.linear_record(before);
-        self.commit(step.time_step.map(|t| t.newmark))
-            .map_err(|failure| FailedAttempt {
-                failure,
-                residuals: report.residuals.clone(),
-            })?;
-        if let Some(t) = step.time_step {
-            self.time = t.end;
-        }
-        Ok(Increment {
-            newton: report,
-            weak_nodes: step.weak_nodes,
-            linear,
-        })
-    }
-    fn steps_done(&self) -> usize {
-        self.step
-    }
-    fn set_steps_done(&mut self, n: usize) {
-        self.step = n;
-    }
-    fn load_steps(&self) -> usize {
-        self.settings.load_steps
-    }
-    fn newton_settings(&self) -> &NewtonSettings {
-        &self.settings.newton
     }
 }

@@ -59,12 +59,22 @@ pub fn require_time_scales(
 /// The steps of a run and its failure, if any: the form the problems record a run in,
 /// whether it converged or stopped at a failing step.
 pub fn steps_and_failure(
-    result: Result<Vec<StepReport>, (Vec<StepReport>, SolveError)>,
+    result: Result<Vec<StepReport>, RunFailure>,
 ) -> (Vec<StepReport>, Option<SolveError>) {
     match result {
         Ok(s) => (s, None),
-        Err((s, e)) => (s, Some(e)),
+        Err(RunFailure { steps, error }) => (steps, Some(error)),
     }
+}
+
+/// A run that stopped at a failing load step: the reports of the steps that converged before
+/// it (the solver holds their state) and the failure.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{error} (after {} converged load steps)", steps.len())]
+pub struct RunFailure {
+    pub steps: Vec<StepReport>,
+    #[source]
+    pub error: SolveError,
 }
 
 /// One attempt at an increment inside a load step that needed cutbacks.
@@ -219,8 +229,8 @@ pub trait LoadStepping {
     }
 
     /// Run all remaining load steps. On failure returns the reports of the converged steps
-    /// and the error; the solver then holds the last converged state.
-    fn run(&mut self) -> Result<Vec<StepReport>, (Vec<StepReport>, SolveError)> {
+    /// and the error ([`RunFailure`]); the solver then holds the last converged state.
+    fn run(&mut self) -> Result<Vec<StepReport>, RunFailure> {
         self.run_observed(&mut |_, _| {})
     }
 
@@ -229,7 +239,7 @@ pub trait LoadStepping {
     fn run_observed(
         &mut self,
         after_step: &mut dyn FnMut(&Self, &StepReport),
-    ) -> Result<Vec<StepReport>, (Vec<StepReport>, SolveError)> {
+    ) -> Result<Vec<StepReport>, RunFailure> {
         let mut reports = Vec::with_capacity(self.load_steps().min(1024));
         while self.steps_done() < self.load_steps() {
             match self.step() {
@@ -237,7 +247,12 @@ pub trait LoadStepping {
                     after_step(self, &r);
                     reports.push(r)
                 }
-                Err(e) => return Err((reports, e)),
+                Err(error) => {
+                    return Err(RunFailure {
+                        steps: reports,
+                        error,
+                    })
+                }
             }
         }
         Ok(reports)

@@ -134,7 +134,7 @@ fn fem_patch_test_homogeneous_finite_deformation() {
                 };
                 let model = Box::new(LinearElastic::try_new(e, nu).unwrap());
                 let mut fem = LineFem::try_new(mesh.clone(), 1.0, model, vec![0], loads, settings).unwrap();
-                fem.run().map_err(|(_, e)| e.to_string()).unwrap();
+                fem.run().map_err(|f| f.error.to_string()).unwrap();
                 let f_exact = f_from_cauchy_stress(p / m);
                 let tag = format!("{:?}, {gauss_points} Gauss points, P = {p}", mesh.element);
                 for (x, x0) in fem.mesh.nodes.iter().zip(&fem.mesh0.nodes) {
@@ -198,7 +198,7 @@ fn fem_quadratic_reproduces_linear_strain_small_strain() {
         };
         let model = Box::new(LinearElastic::try_new(young, 0.0).unwrap());
         let mut fem = LineFem::try_new(mesh, density, model, vec![0], loads, settings).unwrap();
-        fem.run().map_err(|(_, e)| e.to_string()).unwrap();
+        fem.run().map_err(|f| f.error.to_string()).unwrap();
         (0..fem.gauss.len())
             .map(|q| {
                 let z = fem.gauss.position0[q];

@@ -185,7 +185,7 @@ fn cg_agrees_with_the_direct_solver_on_the_fem_compaction_and_newton_stays_quadr
 /// Run an MPM solver with `solver` and return it with its step reports.
 fn run_mpm<const D: usize>(mut s: MpmSolver<D>, solver: LinearSolver) -> (MpmSolver<D>, Vec<StepReport>) {
     s.settings.linear_solver = solver;
-    let r = s.run().unwrap_or_else(|(_, e)| panic!("{solver:?}: {e}"));
+    let r = s.run().unwrap_or_else(|f| panic!("{solver:?}: {}", f.error));
     (s, r)
 }
 
