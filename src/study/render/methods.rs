@@ -3,6 +3,7 @@
 //! figures, from `methods.json` only ([`crate::study::methods`] gathers it).
 
 use crate::basis::method::Method;
+use crate::basis::Basis;
 use crate::study::methods::{MethodsResults, RateRow};
 use crate::study::render::plot2d::{xy_svg, LegendCorner, XyAxes, XySeries};
 use crate::study::results::read_json;
@@ -15,16 +16,14 @@ pub const REPORT: &str = "report.md";
 /// The gathered results' file name.
 pub const RESULTS: &str = "methods.json";
 
-/// Column order of the tables: the paper's methods, the other families, then FEM.
-fn order(m: &Method) -> (u8, String) {
-    let rank = match m.name() {
-        "igimp" => 0,
-        "mpm" => 1,
-        "cpdi" => 2,
-        "bspline2" => 3,
-        "bspline3" => 4,
-        "tlmpm" => 5,
-        _ => 6,
+/// Column order of the tables: the paper's method (iGIMP) first, then the other material point
+/// families in their declaration order ([`Basis::ALL`]), then the finite elements by name — so
+/// a new family takes its column without a line here.
+fn order(m: &Method) -> (usize, String) {
+    let rank = match m {
+        _ if *m == Method::IGIMP => 0,
+        Method::MaterialPoint(b) => 1 + Basis::ALL.iter().position(|x| x == b).unwrap_or(0),
+        Method::Fem(_) => 1 + Basis::ALL.len(),
     };
     (rank, m.name().to_string())
 }
