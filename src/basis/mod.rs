@@ -11,6 +11,7 @@
 //! and never allocates.
 
 pub mod bspline;
+pub mod bspline_gimp;
 pub mod cpdi;
 pub mod gimp;
 pub mod linear;
@@ -18,6 +19,7 @@ pub mod method;
 pub mod total_lagrangian;
 
 pub use bspline::{BsplineKernel, SplineBoundary, SplineDegree};
+pub use bspline_gimp::BsplineGimpKernel;
 pub use cpdi::Cpdi;
 pub use gimp::{gimp_element_weights, GimpKernel};
 pub use linear::LinearKernel;
@@ -413,7 +415,7 @@ macro_rules! basis_families {
         /// Which basis family a material point solver uses. The serialised names are the
         /// families' method names apart from GIMP's (`gimp`; the method is `igimp`).
         #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize, Hash)]
-        #[serde(rename_all = "lowercase")]
+        #[serde(rename_all = "kebab-case")]
         pub enum Basis {
             $($(#[$doc])* $variant,)*
         }
@@ -471,6 +473,12 @@ const BSPLINE3: TensorProduct<BsplineKernel> = TensorProduct(BsplineKernel {
     degree: SplineDegree::Cubic,
     boundary: SplineBoundary::LinearExtrapolation,
 });
+const BSPLINE2_GIMP: TensorProduct<BsplineGimpKernel> = TensorProduct(BsplineGimpKernel {
+    degree: SplineDegree::Quadratic,
+});
+const BSPLINE3_GIMP: TensorProduct<BsplineGimpKernel> = TensorProduct(BsplineGimpKernel {
+    degree: SplineDegree::Cubic,
+});
 const TLMPM: TotalLagrangian<TensorProduct<LinearKernel>> = TotalLagrangian(TensorProduct(LinearKernel));
 
 basis_families! {
@@ -486,11 +494,16 @@ basis_families! {
     Bspline3 => BSPLINE3, axis Some(&BSPLINE3.0), method "bspline3", label "cubic B-spline MPM";
     /// Total-Lagrangian MPM: linear hats in the reference configuration ([`total_lagrangian`]).
     Tlmpm => TLMPM, axis None, method "tlmpm", label "TLMPM";
+    /// Quadratic B-splines averaged over the point's domain ([`bspline_gimp`]).
+    Bspline2Gimp => BSPLINE2_GIMP, axis Some(&BSPLINE2_GIMP.0), method "bspline2-gimp", label "quadratic B-spline GIMP";
+    /// Cubic B-splines averaged over the point's domain ([`bspline_gimp`]).
+    Bspline3Gimp => BSPLINE3_GIMP, axis Some(&BSPLINE3_GIMP.0), method "bspline3-gimp", label "cubic B-spline GIMP";
 }
 
 impl Basis {
     /// True if the family's weights depend on the domain half-lengths, and so on the domain
-    /// update rule (GIMP only; CPDI's domains follow their corners).
+    /// update rule (the domain-averaged kernels: GIMP and the B-spline GIMPs; CPDI's domains
+    /// follow their corners).
     pub fn uses_domain_update(self) -> bool {
         self.axis_kernel().is_some_and(|k| k.has_domain())
     }

@@ -229,7 +229,7 @@ fn compaction_every_family_converges_to_the_q4_reference() {
         }
     }
     let checks: Vec<_> = r.checks.iter().filter(|c| c.id.starts_with("families")).collect();
-    assert_eq!(checks.len(), 7, "{checks:#?}");
+    assert_eq!(checks.len(), 10, "{checks:#?}");
     for c in checks {
         assert_eq!(c.pass, Some(true), "{c:#?}");
     }

@@ -7,8 +7,8 @@
 use crate::common::Rng;
 use igimp::basis::method::Method;
 use igimp::basis::{
-    cpdi, Basis, BasisFamily, BsplineKernel, PointSupport, PointView, SplineBoundary, SplineDegree,
-    TensorProduct,
+    cpdi, Basis, BasisFamily, BsplineGimpKernel, BsplineKernel, PointSupport, PointView, SplineBoundary,
+    SplineDegree, TensorProduct,
 };
 use igimp::mesh::grid::Grid;
 use igimp::mpm::particles::MaterialPoints;
@@ -359,7 +359,8 @@ impl igimp::basis::AxisKernel for SplineFilledInItsCell {
 /// Every node a point's weights reach is a node of a cell with ghost fill (so that the ghost
 /// penalty can hold it), for every family without tracked corners (CPDI's reach is checked
 /// the other way round by the ghost's `retain_reached`), on 40 seeded points with random
-/// domains; the B-spline with the point's own cell as its fill leaves nodes unseen.
+/// domains; the B-spline with the point's own cell as its fill, and the domain-averaged spline
+/// with its domain as its fill, leave nodes unseen.
 #[test]
 fn the_ghost_fill_covers_every_node_a_family_reaches() {
     let grid = Grid::<2>::try_new([0.0, 0.0], [1.0, 1.0], [10, 10]).unwrap();
@@ -370,13 +371,10 @@ fn the_ghost_fill_covers_every_node_a_family_reaches() {
         let r = SVector::<f64, 2>::from_fn(|_, _| rng.uniform(0.05, 0.5));
         points.push(x, r, 1.0);
     }
-    for basis in [
-        Basis::Mpm,
-        Basis::Gimp,
-        Basis::Bspline2,
-        Basis::Bspline3,
-        Basis::Tlmpm,
-    ] {
+    for basis in Basis::ALL
+        .into_iter()
+        .filter(|&b| !b.family::<2>().needs_corners())
+    {
         let unseen = nodes_unseen_by_the_ghost(basis.family::<2>(), &points, &grid);
         assert_eq!(
             unseen, 0,
@@ -392,4 +390,39 @@ fn the_ghost_fill_covers_every_node_a_family_reaches() {
         unseen > 0,
         "the spline filled in its own cell should leave reached nodes unseen"
     );
+    // The domain-averaged spline with GIMP's fill (its domain alone) misses the nodes its
+    // spline reaches beyond the domain.
+    let wrong = TensorProduct(SplineGimpFilledOverItsDomain(BsplineGimpKernel {
+        degree: SplineDegree::Quadratic,
+    }));
+    let unseen = nodes_unseen_by_the_ghost(&wrong, &points, &grid);
+    assert!(
+        unseen > 0,
+        "the averaged spline filled over its domain should leave reached nodes unseen"
+    );
+}
+
+/// The domain-averaged quadratic spline with GIMP's fill rule (the domain x ± r): the wrong
+/// variant for the averaged splines.
+struct SplineGimpFilledOverItsDomain(BsplineGimpKernel);
+
+impl igimp::basis::AxisKernel for SplineGimpFilledOverItsDomain {
+    fn support_nodes(&self) -> usize {
+        self.0.support_nodes()
+    }
+    fn has_domain(&self) -> bool {
+        true
+    }
+    fn fill_half_width(&self, _spacing: f64, r: f64) -> Option<f64> {
+        Some(r)
+    }
+    fn axis_weights(
+        &self,
+        axis: igimp::basis::GridAxis,
+        x: f64,
+        r: f64,
+        out: &mut igimp::basis::AxisWeights,
+    ) -> Result<(), igimp::basis::BasisError> {
+        self.0.axis_weights(axis, x, r, out)
+    }
 }
