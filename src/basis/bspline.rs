@@ -18,7 +18,9 @@ use super::{AxisKernel, AxisWeights, BasisError, GridAxis};
 /// The spline degree.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SplineDegree {
+    /// Quadratic: reaches 1.5h from its node, 3 nodes per axis.
     Quadratic,
+    /// Cubic: reaches 2h from its node, 4 nodes per axis.
     Cubic,
 }
 
@@ -36,7 +38,9 @@ pub enum SplineBoundary {
 /// The B-spline kernel along one axis.
 #[derive(Debug, Clone, Copy)]
 pub struct BsplineKernel {
+    /// Quadratic or cubic splines.
     pub degree: SplineDegree,
+    /// What becomes of the weights of nodes beyond the grid.
     pub boundary: SplineBoundary,
 }
 

@@ -68,11 +68,17 @@ impl Method {
     pub const BSPLINE3: Method = Method::MaterialPoint(Basis::Bspline3);
     /// Total-Lagrangian MPM.
     pub const TLMPM: Method = Method::MaterialPoint(Basis::Tlmpm);
+    /// Linear (two-noded) line FEM.
     pub const FEM_LINEAR: Method = Method::Fem(Element::Line2);
+    /// Quadratic (three-noded) line FEM.
     pub const FEM_QUADRATIC: Method = Method::Fem(Element::Line3);
+    /// Q4 quadrilateral FEM.
     pub const FEM_Q4: Method = Method::Fem(Element::Q4);
+    /// Q8 quadrilateral FEM.
     pub const FEM_Q8: Method = Method::Fem(Element::Q8);
+    /// Hex8 hexahedral FEM.
     pub const FEM_HEX8: Method = Method::Fem(Element::Hex8);
+    /// Hex20 serendipity hexahedral FEM.
     pub const FEM_HEX20: Method = Method::Fem(Element::Hex20);
 
     /// How many material point families there are ([`Basis::ALL`]): problem method lists are
@@ -170,6 +176,7 @@ impl Method {
         }
     }
 
+    /// True for the finite element comparators.
     pub fn is_fem(self) -> bool {
         matches!(self, Method::Fem(_))
     }

@@ -41,9 +41,13 @@ pub const MAX_POINT_NODES: usize = MAX_AXIS_NODES * MAX_AXIS_NODES * MAX_AXIS_NO
 /// with respect to the grid coordinate.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct AxisWeights {
+    /// Index along this axis of the first grid node the point touches.
     pub first: usize,
+    /// How many consecutive nodes the point touches along this axis (at most [`MAX_AXIS_NODES`]).
     pub len: usize,
+    /// This axis's factor of S_vp for each touched node; entries from `len` on are unused.
     pub w: [f64; MAX_AXIS_NODES],
+    /// Derivative of each `w` along the axis (per unit length); entries from `len` on are unused.
     pub dw: [f64; MAX_AXIS_NODES],
 }
 
@@ -51,11 +55,20 @@ pub struct AxisWeights {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum BasisError {
     /// The point (or its domain) is not inside the grid along this axis.
-    OutsideGrid { axis: usize },
+    OutsideGrid {
+        /// The axis along which the point or domain leaves the grid.
+        axis: usize,
+    },
     /// The domain spans more than `MAX_AXIS_NODES - 1` elements.
-    DomainTooLarge { axis: usize },
+    DomainTooLarge {
+        /// The axis along which the domain is too long.
+        axis: usize,
+    },
     /// The domain half-length is not positive and finite (a collapsed GIMP domain).
-    DegenerateDomain { axis: usize },
+    DegenerateDomain {
+        /// The axis along which the half-length collapsed.
+        axis: usize,
+    },
     /// A corner-tracked domain (CPDI) folded over (its map's Jacobian is not positive), or a
     /// total-Lagrangian point's F is singular.
     InvertedDomain,
@@ -89,9 +102,11 @@ impl std::fmt::Display for BasisError {
 pub struct GridAxis {
     /// Which axis (for error messages).
     pub axis: usize,
+    /// Coordinate of the axis's first node.
     pub origin: f64,
     /// Element size h.
     pub spacing: f64,
+    /// Number of elements along the axis.
     pub cells: usize,
 }
 
@@ -224,12 +239,15 @@ impl<const D: usize> Default for PointSupport<D> {
 }
 
 impl<const D: usize> PointSupport<D> {
+    /// Forget every listed node (the storage stays).
     pub fn clear(&mut self) {
         self.len = 0;
     }
+    /// Number of nodes listed.
     pub fn len(&self) -> usize {
         self.len
     }
+    /// True if no node is listed.
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
@@ -267,15 +285,19 @@ impl<const D: usize> PointSupport<D> {
     pub fn node(&self, k: usize) -> (usize, f64, SVector<f64, D>) {
         (self.nodes[k], self.w[k], self.g[k])
     }
+    /// Flat grid indices of the listed nodes.
     pub fn nodes(&self) -> &[usize] {
         &self.nodes[..self.len]
     }
+    /// S_vp of each listed node, in the order of [`Self::nodes`].
     pub fn weights(&self) -> &[f64] {
         &self.w[..self.len]
     }
+    /// ∂S_vp/∂x of each listed node, in the order of [`Self::nodes`].
     pub fn gradients(&self) -> &[SVector<f64, D>] {
         &self.g[..self.len]
     }
+    /// The gradients, for a family that maps them after evaluation (TLMPM's push-forward).
     pub fn gradients_mut(&mut self) -> &mut [SVector<f64, D>] {
         &mut self.g[..self.len]
     }
@@ -541,6 +563,7 @@ impl Basis {
 /// Tensor-product support of one point: the nodes it touches with their weights and gradients.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Support<const D: usize> {
+    /// The point's weights along each axis; the support is their tensor product.
     pub axes: [AxisWeights; D],
 }
 
@@ -558,6 +581,7 @@ impl<const D: usize> Support<D> {
     pub fn len(&self) -> usize {
         self.axes.iter().map(|a| a.len).product()
     }
+    /// True if some axis touches no node.
     #[inline]
     pub fn is_empty(&self) -> bool {
         self.len() == 0

@@ -19,6 +19,7 @@ pub struct SupportTable<const D: usize> {
 }
 
 impl<const D: usize> SupportTable<D> {
+    /// Empty the table for a new step (the storage stays).
     pub fn clear(&mut self) {
         self.offsets.clear();
         self.offsets.push(0);
@@ -45,6 +46,7 @@ impl<const D: usize> SupportTable<D> {
         );
         self.offsets.push(self.nodes.len());
     }
+    /// Number of points closed by [`Self::finish_point`].
     pub fn num_points(&self) -> usize {
         self.offsets.len().saturating_sub(1)
     }
@@ -148,6 +150,7 @@ impl DofMap {
     pub fn len(&self) -> usize {
         self.count
     }
+    /// True if no dof has an equation.
     pub fn is_empty(&self) -> bool {
         self.count == 0
     }

@@ -135,10 +135,12 @@ impl GhostSettings {
     /// enough that the penalty cannot swamp the material stiffness by round-off.
     pub const MAX_GAMMA: f64 = 1e3;
 
+    /// True if the penalty is applied (γ > 0).
     pub fn is_on(&self) -> bool {
         self.gamma > 0.0
     }
 
+    /// Check γ, `cut_fill` and `cut_share` against their ranges.
     pub fn validate(&self) -> Result<(), InputError> {
         if !(self.gamma.is_finite() && (0.0..=Self::MAX_GAMMA).contains(&self.gamma)) {
             return Err(InputError::new(

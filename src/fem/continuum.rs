@@ -29,6 +29,7 @@ pub struct PlaneFemSettings {
     /// (2 for Q4 and Hex8, 3 for Q8 and Hex20).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gauss_points: Option<usize>,
+    /// Newton iteration settings of each load step.
     pub newton: NewtonSettings,
     /// Number of equal load increments.
     pub load_steps: usize,
@@ -50,6 +51,7 @@ impl Default for PlaneFemSettings {
 }
 
 impl PlaneFemSettings {
+    /// Check the Gauss rule (if given), the Newton settings and the number of load steps.
     pub fn validate(&self) -> Result<(), InputError> {
         if let Some(n) = self.gauss_points {
             crate::mesh::quadrature::GaussRule::try_new(n)?;
@@ -100,10 +102,13 @@ pub struct ContinuumFem<const D: usize, E> {
     pub mesh0: ElementMesh<D, E>,
     /// Current mesh (nodes moved with the material).
     pub mesh: ElementMesh<D, E>,
+    /// The Gauss points with their committed states.
     pub gauss: GaussPoints<SVector<f64, D>>,
     /// Nodal dofs with zero displacement: (node, axis).
     pub fixed: Vec<(usize, usize)>,
+    /// Loads at the end of the analysis.
     pub loads: FemLoads<D>,
+    /// Gauss rule, Newton, load-stepping and linear solver settings.
     pub settings: PlaneFemSettings,
     /// `loads.nodal_forces` as (dof, force) pairs.
     dof_forces: Vec<(usize, f64)>,

@@ -69,6 +69,7 @@ impl LineElement {
 /// uses nodes `k e ..= k e + k` (k the degree), so a quadratic element's mid node is `2e + 1`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LineMesh {
+    /// The element family (linear or quadratic).
     pub element: LineElement,
     /// Node coordinates.
     pub nodes: Vec<f64>,
@@ -139,10 +140,12 @@ impl LineMesh {
         Ok(mesh)
     }
 
+    /// Number of elements.
     pub fn num_elements(&self) -> usize {
         (self.nodes.len() - 1) / self.element.degree()
     }
 
+    /// Number of nodes, mid nodes included.
     pub fn num_nodes(&self) -> usize {
         self.nodes.len()
     }

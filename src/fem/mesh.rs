@@ -34,6 +34,7 @@ pub trait ElementFamily<const D: usize>: Copy + Debug + PartialEq + Send + Sync 
             2
         }
     }
+    /// Nodes per element.
     fn nodes_per_element(self) -> usize {
         self.local_nodes().len()
     }
@@ -116,6 +117,7 @@ pub(crate) fn det_inverse<const D: usize>(jac: &SMatrix<f64, D, D>) -> (f64, Opt
 /// [`ElementFamily::nodes_per_element`] per element).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ElementMesh<const D: usize, E> {
+    /// The element family of every element.
     pub element: E,
     /// Node coordinates.
     pub nodes: Vec<SVector<f64, D>>,
@@ -257,10 +259,12 @@ impl<const D: usize, E: ElementFamily<D>> ElementMesh<D, E> {
         Self::try_new(element, nodes, connectivity)
     }
 
+    /// Number of elements.
     pub fn num_elements(&self) -> usize {
         self.connectivity.len() / self.element.nodes_per_element()
     }
 
+    /// Number of nodes.
     pub fn num_nodes(&self) -> usize {
         self.nodes.len()
     }

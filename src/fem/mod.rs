@@ -78,12 +78,14 @@ use updated_lagrangian::{fem_advance, fem_step_system, UlCore};
 pub struct LineFemSettings {
     /// Gauss points per element, 1..=5.
     pub gauss_points: usize,
+    /// Newton iteration settings of each load step.
     pub newton: NewtonSettings,
     /// Number of equal load increments.
     pub load_steps: usize,
 }
 
 impl LineFemSettings {
+    /// Check the Gauss rule, the Newton settings and the number of load steps.
     pub fn validate(&self) -> Result<(), InputError> {
         GaussRule::try_new(self.gauss_points)?;
         validate_stepping(&self.newton, self.load_steps)
@@ -105,10 +107,13 @@ pub struct LineFem {
     pub mesh0: LineMesh,
     /// Current mesh (nodes moved with the material).
     pub mesh: LineMesh,
+    /// The Gauss points with their committed states.
     pub gauss: GaussPoints,
     /// Nodes with zero displacement.
     pub fixed: Vec<usize>,
+    /// Loads at the end of the analysis.
     pub loads: LineLoads,
+    /// Gauss rule, Newton and load-stepping settings.
     pub settings: LineFemSettings,
     rule: GaussRule,
     core: UlCore<1>,

@@ -62,9 +62,11 @@ impl<X> Default for GaussPoints<X> {
 }
 
 impl<X> GaussPoints<X> {
+    /// Number of Gauss points.
     pub fn len(&self) -> usize {
         self.xi.len()
     }
+    /// True if there are no Gauss points.
     pub fn is_empty(&self) -> bool {
         self.xi.is_empty()
     }
@@ -293,6 +295,7 @@ impl<const D: usize> UlCore<D> {
 pub trait FemMesh<const D: usize> {
     /// Local coordinate of a Gauss point in its element.
     type Local;
+    /// Number of mesh nodes.
     fn num_nodes(&self) -> usize;
     /// Fill `table` with, for each Gauss point (element `elements[p]`, local coordinate
     /// `xis[p]`), its element's nodes, N_a(ξ_q) and ∂N_a/∂X̃ on the current mesh (eqs 33–34).

@@ -51,12 +51,15 @@ impl<const D: usize> Grid<D> {
         })
     }
 
+    /// Coordinates of the lower corner (node 0).
     pub fn origin(&self) -> [f64; D] {
         self.origin
     }
+    /// Element size h along each axis.
     pub fn spacing(&self) -> [f64; D] {
         self.spacing
     }
+    /// Number of elements along each axis.
     pub fn cells(&self) -> [usize; D] {
         self.cells
     }
@@ -64,12 +67,15 @@ impl<const D: usize> Grid<D> {
     pub fn upper(&self, axis: usize) -> f64 {
         self.origin[axis] + self.spacing[axis] * self.cells[axis] as f64
     }
+    /// Number of nodes along `axis`.
     pub fn nodes_along(&self, axis: usize) -> usize {
         self.cells[axis] + 1
     }
+    /// Total number of nodes.
     pub fn num_nodes(&self) -> usize {
         (0..D).map(|a| self.nodes_along(a)).product()
     }
+    /// Total number of elements.
     pub fn num_cells(&self) -> usize {
         self.cells.iter().product()
     }

@@ -36,12 +36,16 @@ pub struct Loads<const D: usize> {
 
 /// Implicit MPM / GIMP solver for `D` dimensions.
 pub struct MpmSolver<const D: usize> {
+    /// The background grid, the same at every step.
     pub grid: Grid<D>,
+    /// The material points with their committed states.
     pub points: MaterialPoints<D>,
     model: Box<dyn ConstitutiveModel>,
     /// Homogeneous Dirichlet conditions: (node, axis).
     pub fixed: Vec<(usize, usize)>,
+    /// Loads at the end of the analysis.
     pub loads: Loads<D>,
+    /// Basis, Newton, load stepping, ghost penalty and the other solver settings.
     pub settings: MpmSettings,
     step: usize,
     work: StepWorkspace<D>,
@@ -66,6 +70,10 @@ struct NodalMotion {
 }
 
 impl<const D: usize> MpmSolver<D> {
+    /// A solver of `points` (at least one) on `grid` with the constitutive `model`, the
+    /// Dirichlet dofs `fixed` (node, axis), `loads` and `settings`. Every point's domain must
+    /// lie inside the grid and every fixed dof and point load must name an existing node or
+    /// point.
     pub fn try_new(
         grid: Grid<D>,
         points: MaterialPoints<D>,

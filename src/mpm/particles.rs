@@ -27,6 +27,7 @@ pub struct MaterialPoints<const D: usize> {
     /// Velocity v_p and acceleration a_p (dynamic analyses, [`crate::solver::dynamics`]; zero at
     /// rest, and untouched by quasi-static ones).
     pub velocity: Vec<SVector<f64, D>>,
+    /// Acceleration a_p (dynamic analyses; zero at rest).
     pub acceleration: Vec<SVector<f64, D>>,
     /// Domain corners, 2^D per point (axis 0 fastest), for the families that track them
     /// (CPDI); empty otherwise ([`Self::track_corners`]).
@@ -34,9 +35,11 @@ pub struct MaterialPoints<const D: usize> {
 }
 
 impl<const D: usize> MaterialPoints<D> {
+    /// Number of points.
     pub fn len(&self) -> usize {
         self.position.len()
     }
+    /// True if there are no points.
     pub fn is_empty(&self) -> bool {
         self.position.is_empty()
     }

@@ -12,8 +12,11 @@ use serde::{Deserialize, Serialize};
 /// Solver settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MpmSettings {
+    /// The basis family of the weights S_vp.
     pub basis: Basis,
+    /// How the domain half-lengths follow the deformation at each commit (§3.3).
     pub domain_update: DomainUpdate,
+    /// Newton iteration settings of each load step.
     pub newton: NewtonSettings,
     /// Number of equal load increments.
     pub load_steps: usize,
@@ -22,8 +25,10 @@ pub struct MpmSettings {
     /// singular and is treated by `weak_node_treatment` for the step. 0 disables.
     #[serde(default)]
     pub weak_node_tolerance: f64,
+    /// What is done to a weak node (see `weak_node_tolerance`).
     #[serde(default)]
     pub weak_node_treatment: WeakNodeTreatment,
+    /// How a point's committed volume is obtained (eq 28).
     #[serde(default)]
     pub volume_update: VolumeUpdate,
     /// Sparse factorisation of the tangent: LU (default) or, for the symmetric tangents of
@@ -89,6 +94,7 @@ pub enum WeakNodeTreatment {
 }
 
 impl MpmSettings {
+    /// Check every setting against its range.
     pub fn validate(&self) -> Result<(), InputError> {
         self.newton.validate()?;
         self.ghost.validate()?;

@@ -83,8 +83,10 @@ pub struct Newmark {
     /// Newmark γ ∈ [1/2, 1]; 1/2 by default (no numerical damping).
     #[serde(default = "half")]
     pub gamma: f64,
+    /// The mass matrix of the inertia term.
     #[serde(default)]
     pub mass: MassMatrix,
+    /// How the external load varies in time.
     #[serde(default)]
     pub load: LoadHistory,
     /// Generalised-α (Chung & Hulbert 1993) instead of plain Newmark: the spectral radius ρ∞ ∈
@@ -120,9 +122,13 @@ pub struct Newmark {
 /// effective tangent K + c_m M/(βΔt²).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeneralizedAlpha {
+    /// α_m = (2ρ∞ − 1)/(ρ∞ + 1): the weight of the start-of-step acceleration.
     pub alpha_m: f64,
+    /// α_f = ρ∞/(ρ∞ + 1): the weight of the start-of-step forces.
     pub alpha_f: f64,
+    /// Newmark β = ¼ (1 − α_m + α_f)².
     pub beta: f64,
+    /// Newmark γ = ½ − α_m + α_f.
     pub gamma: f64,
 }
 
@@ -183,6 +189,8 @@ impl Newmark {
         }
     }
 
+    /// Check the duration, β, γ and ρ∞ against their ranges (β and γ left at their defaults
+    /// when ρ∞ is given).
     pub fn validate(&self) -> Result<(), InputError> {
         require_positive("dynamics.duration", self.duration)?;
         if !(self.beta > 0.0 && self.beta <= 0.5) {
@@ -248,8 +256,11 @@ impl Newmark {
 /// the external loads take there.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TimeStep {
+    /// The step's coefficients, Δt = t₁ − the committed time.
     pub newmark: NewmarkStep,
+    /// End time t₁ of the step.
     pub end: f64,
+    /// The factor the external loads take at t₁ ([`LoadHistory::factor`]).
     pub load_factor: f64,
 }
 
@@ -257,10 +268,15 @@ pub struct TimeStep {
 /// Newmark).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewmarkStep {
+    /// Step length Δt.
     pub dt: f64,
+    /// Newmark β.
     pub beta: f64,
+    /// Newmark γ.
     pub gamma: f64,
+    /// Generalised-α's α_m (0 for Newmark).
     pub alpha_m: f64,
+    /// Generalised-α's α_f (0 for Newmark).
     pub alpha_f: f64,
 }
 
@@ -344,6 +360,7 @@ pub struct BodyForce<const D: usize>(Arc<BodyForceFn<D>>);
 type BodyForceFn<const D: usize> = dyn Fn(&SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync;
 
 impl<const D: usize> BodyForce<D> {
+    /// The body force b₀ = `f`(X, t).
     pub fn new(f: impl Fn(&SVector<f64, D>, f64) -> SVector<f64, D> + Send + Sync + 'static) -> Self {
         BodyForce(Arc::new(f))
     }
@@ -391,12 +408,16 @@ impl<const D: usize> std::fmt::Debug for BodyForce<D> {
 /// mass of each integration point (m_p; for the finite elements ρ₀ w det J₀ of each Gauss point).
 #[derive(Debug, Clone, Copy)]
 pub struct Inertia<'a> {
+    /// The step's Newmark (or generalised-α) coefficients.
     pub step: NewmarkStep,
+    /// The negated predictor ã per nodal dof (a₁ = Δu/(βΔt²) − ã).
     pub predictor: &'a [f64],
     /// The start-of-step acceleration a₀ per nodal dof (for the scale of the convergence
     /// test, [`crate::discretise::assembly::DynamicReference`]).
     pub acceleration: &'a [f64],
+    /// Consistent or lumped mass.
     pub mass: MassMatrix,
+    /// Mass of each integration point: m_p, or ρ₀ w_q det J₀ for a Gauss point.
     pub point_masses: &'a [f64],
 }
 

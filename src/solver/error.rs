@@ -16,6 +16,8 @@ pub struct InputError {
 }
 
 impl InputError {
+    /// The error of `field` = `value`, with what is `allowed`; long numbers are shortened
+    /// ([`tidy_numbers`]).
     pub fn new(field: impl Into<String>, value: impl ToString, allowed: impl Into<String>) -> Self {
         Self {
             field: field.into(),
@@ -113,23 +115,54 @@ pub fn require_count(field: &str, value: usize, min: usize) -> Result<(), InputE
 /// Why a load step failed.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum StepFailure {
+    /// Newton used its iterations without meeting the tolerance, and did not stall.
     #[error("Newton did not converge in {iterations} iterations (last normalised residual {last:.3e})")]
-    NotConverged { iterations: usize, last: f64 },
+    NotConverged {
+        /// Newton iterations done ([`crate::solver::newton::NewtonSettings::max_iterations`]).
+        iterations: usize,
+        /// The normalised residual after the last iteration.
+        last: f64,
+    },
+    /// Newton used its iterations stuck at a round-off floor too far above the tolerance to
+    /// accept ([`crate::solver::newton::FLOOR_ACCEPT_FACTOR`]).
     #[error("Newton stalled at its round-off floor after {iterations} iterations: the residual stays near {floor:.1e} (best {best:.1e}), above the tolerance {tolerance:.1e}; the tangent is too ill-conditioned for this tolerance (e.g. near-incompressible material): raise newton.tolerance above the floor or change the discretisation")]
     Stalled {
+        /// Newton iterations done.
         iterations: usize,
+        /// The floor estimate: the median normalised residual of the stalled iterations.
         floor: f64,
+        /// The smallest normalised residual reached.
         best: f64,
+        /// The Newton tolerance the floor stays above.
         tolerance: f64,
     },
+    /// The residual or the update turned NaN or infinite.
     #[error("non-finite residual or update at Newton iteration {iteration}")]
-    NonFinite { iteration: usize },
+    NonFinite {
+        /// The Newton iteration (0: the residual at the starting point).
+        iteration: usize,
+    },
+    /// The linear solve of a Newton iteration failed.
     #[error("the linear solve failed: {0}")]
     LinearSolve(SolverError),
+    /// A material point's weights could not be formed: it or its domain left the grid (or the
+    /// domain grew too long).
     #[error("material point {point} left the background grid (position {position})")]
-    LeftGrid { point: usize, position: String },
+    LeftGrid {
+        /// Index of the material point.
+        point: usize,
+        /// Its position and the basis's reason, formatted.
+        position: String,
+    },
+    /// An integration point's kinematics failed (e.g. det ΔF ≤ 0, an inverted element, a
+    /// collapsed or inverted domain, a non-finite body force).
     #[error("material point {point}: {reason}")]
-    Kinematics { point: usize, reason: String },
+    Kinematics {
+        /// Index of the integration point (material point or Gauss point).
+        point: usize,
+        /// What failed, in words.
+        reason: String,
+    },
 }
 
 /// One attempt at a load step that failed: why, and the normalised residuals of its Newton
@@ -137,7 +170,9 @@ pub enum StepFailure {
 #[derive(Debug, Clone, PartialEq, Error)]
 #[error("{failure}")]
 pub struct FailedAttempt {
+    /// Why the attempt failed.
     pub failure: StepFailure,
+    /// Normalised out-of-balance force per Newton iteration before the failure.
     pub residuals: Vec<f64>,
 }
 
@@ -157,6 +192,7 @@ impl From<StepFailure> for FailedAttempt {
 pub struct SolveError {
     /// Load step number, counted from 1.
     pub step: usize,
+    /// Why the last attempt failed.
     pub failure: StepFailure,
     /// Normalised out-of-balance force per Newton iteration of the failing attempt.
     pub residuals: Vec<f64>,

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 /// `x = M⁻¹ b` for a fixed preconditioner M.
 pub trait Preconditioner {
+    /// Write M⁻¹ `b` into `x`.
     fn apply(&self, b: &[f64], x: &mut [f64]) -> Result<(), SolverError>;
 }
 
@@ -29,6 +30,7 @@ pub fn dot(u: &[f64], v: &[f64]) -> f64 {
 /// What a preconditioned Krylov solve ([`pcg`] or [`gmres`]) did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KrylovReport {
+    /// Krylov iterations taken.
     pub iterations: usize,
     /// ‖b − A x‖ / ‖b‖ at the end.
     pub relative_residual: f64,

@@ -70,6 +70,7 @@ pub const REUSE_FACTOR: f64 = 1.5;
 /// What the linear solves of a system have cost so far (for the performance figures).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct LinearStats {
+    /// Linear solves performed (empty systems not counted).
     pub solves: usize,
     /// Krylov iterations summed over the iterative solves: CG's, and GMRES's where CG gave up
     /// ([`Self::gmres_solves`]).
@@ -154,6 +155,7 @@ impl SparseSystem {
         self.matrix.set_by_rows(solver == LinearSolver::Iterative);
     }
 
+    /// The chosen factorisation or iterative strategy.
     pub fn solver(&self) -> LinearSolver {
         self.solver
     }

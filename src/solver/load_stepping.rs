@@ -72,7 +72,9 @@ pub fn steps_and_failure(
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{error} (after {} converged load steps)", steps.len())]
 pub struct RunFailure {
+    /// Reports of the load steps that converged before the failure.
     pub steps: Vec<StepReport>,
+    /// The failure of the load step that stopped the run.
     #[source]
     pub error: SolveError,
 }
@@ -96,6 +98,7 @@ pub struct SubStep {
 pub struct StepReport {
     /// Load step number, from 1.
     pub step: usize,
+    /// Total load factor reached (the step's nominal level `step / load_steps`).
     pub load_factor: f64,
     /// The Newton solve that reached `load_factor` (the last sub-step).
     pub newton: NewtonReport,
@@ -123,19 +126,25 @@ impl StepReport {
 /// (CG's plus GMRES's where CG gave up; 0 for direct solves).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct LinearRecord {
+    /// Number of equations of the tangent.
     pub unknowns: usize,
+    /// Stored entries of the tangent's sparsity pattern.
     pub nonzeros: usize,
+    /// Non-zeros of the last LDLᵀ/LLᵀ factor (0 if none; always 0 under the iterative strategy).
     #[serde(default)]
     pub factor_nonzeros: usize,
+    /// Krylov iterations of the increment's solves (0 for direct solves).
     pub iterations: usize,
 }
 
 /// One converged increment, as a solver reports it to the load stepping.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Increment {
+    /// The Newton solve of the increment.
     pub newton: NewtonReport,
     /// Grid nodes constrained by the weak-node treatment (0 for FEM).
     pub weak_nodes: usize,
+    /// The size of the increment's linear systems and their Krylov iterations.
     pub linear: LinearRecord,
 }
 

@@ -48,9 +48,13 @@ pub const MAX_LEVELS: usize = 24;
 /// per axis, `dim` the problem's dimension.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct DofGeometry {
+    /// The problem's dimension (1, 2 or 3).
     pub dim: usize,
+    /// The level's grid spacing per axis (on the finest level, the grid's or mesh's element size).
     pub spacing: [f64; 3],
+    /// Position of each equation's node, padded with zeros to three components.
     pub positions: Vec<[f64; 3]>,
+    /// Displacement component (axis) each equation carries.
     pub components: Vec<u8>,
 }
 
@@ -59,8 +63,11 @@ pub struct DofGeometry {
 /// ([`DofGeometry::of_equations`]).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct NodeGeometry {
+    /// The problem's dimension (1, 2 or 3).
     pub dim: usize,
+    /// Position of each node, padded with zeros to three components.
     pub positions: Vec<[f64; 3]>,
+    /// The fine grid spacing (or mesh element size) per axis.
     pub spacing: [f64; 3],
 }
 

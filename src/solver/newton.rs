@@ -71,6 +71,7 @@ impl Default for NewtonSettings {
 }
 
 impl NewtonSettings {
+    /// Check the tolerance, the iteration limit and the cutback limit against their ranges.
     pub fn validate(&self) -> Result<(), InputError> {
         if !(self.tolerance.is_finite() && (MIN_TOLERANCE..1.0).contains(&self.tolerance)) {
             return Err(InputError::new(

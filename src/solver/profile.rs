@@ -99,11 +99,15 @@ pub fn timed<R>(phase: Phase, f: impl FnOnce() -> R) -> R {
 pub struct CaseCost {
     /// Wall seconds of the whole case (solve, records, side files).
     pub seconds: f64,
+    /// Seconds in supports and weights or shape functions ([`Phase::Weights`]).
     pub weights: f64,
+    /// Seconds in point updates and the internal force ([`Phase::Constitutive`]).
     pub constitutive: f64,
+    /// Seconds in tangent assembly ([`Phase::Assembly`]).
     pub assembly: f64,
     /// Pattern, factorisation or multigrid set-up.
     pub setup: f64,
+    /// Seconds in triangular solves or Krylov iterations ([`Phase::Solve`]).
     pub solve: f64,
     /// Most heap bytes the case held at once, above what it started with (absent when the
     /// binary does not count allocations).

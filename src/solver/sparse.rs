@@ -29,9 +29,13 @@ pub struct SparseMatrix {
 /// A borrowed column-compressed matrix: what the direct factorisations read.
 #[derive(Debug, Clone, Copy)]
 pub struct CscRef<'a> {
+    /// Order of the (square) matrix.
     pub n: usize,
+    /// Where each column's entries start in `row_idx` and `values` (n + 1 entries).
     pub col_ptr: &'a [usize],
+    /// Row index of each entry, ascending within a column.
     pub row_idx: &'a [u32],
+    /// Value of each entry.
     pub values: &'a [f64],
 }
 
@@ -154,9 +158,11 @@ impl SparseMatrix {
         }
         blocks
     }
+    /// Order of the matrix: the number of equations.
     pub fn dim(&self) -> usize {
         self.stored.rows
     }
+    /// Stored entries of the sparsity pattern.
     pub fn nnz(&self) -> usize {
         self.stored.idx.len()
     }
@@ -301,11 +307,15 @@ fn column_index(c: usize) -> u32 {
 /// ones without a second copy of the pattern (at 31e6 non-zeros, 372 MB).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Csr {
+    /// Number of rows.
     pub rows: usize,
+    /// Number of columns.
     pub cols: usize,
+    /// Where each row's entries start in `idx` and `val` (rows + 1 entries).
     pub ptr: Arc<[usize]>,
     /// Column indices, each row's ascending.
     pub idx: Arc<[u32]>,
+    /// Value of each entry, in the order of `idx`.
     pub val: Vec<f64>,
 }
 
@@ -335,6 +345,7 @@ impl Csr {
         }
     }
 
+    /// Number of stored entries.
     pub fn nnz(&self) -> usize {
         self.idx.len()
     }
@@ -371,6 +382,7 @@ impl Csr {
         });
     }
 
+    /// The diagonal a_ii (0 where the pattern has no entry).
     pub fn diagonal(&self) -> Vec<f64> {
         (0..self.rows)
             .map(|i| {
@@ -396,6 +408,7 @@ impl Csr {
         }
     }
 
+    /// Aᵀ, row-compressed (a new matrix; the structure is not shared).
     pub fn transpose(&self) -> Csr {
         transposed(self.rows, self.cols, &self.ptr, &self.idx, &self.val)
     }

@@ -17,12 +17,17 @@ use rayon::prelude::*;
 
 /// One load step's nonlinear system over a set of integration points.
 pub struct LoadStepSystem<'a, const D: usize> {
+    /// The material's constitutive model.
     pub model: &'a dyn ConstitutiveModel,
+    /// Each point's committed state at the start of the step.
     pub states: &'a [PointState],
+    /// Each point's nodes, weights and gradients on the step's start configuration.
     pub table: &'a SupportTable<D>,
+    /// The equation number of each nodal dof.
     pub dofs: &'a DofMap,
     /// External force in equation order.
     pub f_ext: &'a [f64],
+    /// The tangent K of eq (22) (eq 27 plus any ghost and inertia terms) with its linear solver.
     pub matrix: &'a mut SparseSystem,
     /// Per-point trial results at the last evaluation (committed by the caller on convergence).
     pub trials: &'a mut Vec<Option<PointTrial<D>>>,

@@ -21,9 +21,13 @@ use nalgebra::SVector;
 /// their weights or shape functions and then share everything else.
 #[derive(Debug, Default)]
 pub struct StepWorkspace<const D: usize> {
+    /// Each point's nodes, weights and gradients for the step, filled by the solver before it.
     pub table: SupportTable<D>,
+    /// The sparse tangent with its pattern and linear solver.
     pub matrix: SparseSystem,
+    /// Each point's trial state at the last evaluation (`None`: not evaluated, or it failed).
     pub trials: Vec<Option<PointTrial<D>>>,
+    /// Nodal displacement increment Δu at the last evaluation (dof = node·D + axis).
     pub du_nodal: Vec<f64>,
     /// Internal force at the fixed dofs at the last evaluation (see [`LoadStepSystem`]).
     pub fixed_forces: Vec<f64>,
@@ -43,8 +47,11 @@ pub struct StepWorkspace<const D: usize> {
 
 /// What a load step applies, besides the material model and the committed states.
 pub struct StepInput<'a, const D: usize> {
+    /// The material's constitutive model.
     pub model: &'a dyn ConstitutiveModel,
+    /// Each point's committed state at the start of the step.
     pub states: &'a [PointState],
+    /// Number of nodes of the grid or mesh.
     pub num_nodes: usize,
     /// Homogeneous Dirichlet conditions (node, axis).
     pub fixed: &'a [(usize, usize)],
@@ -66,7 +73,9 @@ pub struct StepInput<'a, const D: usize> {
 /// The external forces at the start of a step, as [`StepInput`] gives those at its end.
 #[derive(Debug, Clone, Copy)]
 pub struct StartForces<'a, const D: usize> {
+    /// Force carried by each point at t₀.
     pub point_forces: &'a [SVector<f64, D>],
+    /// Forces applied directly to nodal dofs at t₀ (dof = node·D + axis).
     pub nodal_forces: &'a [(usize, f64)],
 }
 
