@@ -121,44 +121,58 @@ impl AxisKernel for BsplineKernel {
             SplineDegree::Cubic => (t_c.floor() as i64 - 1, 4),
         };
         let i_hi = i_lo + count - 1;
-        // The nodes inside the grid, widened to the two an extrapolated node folds onto.
-        let mut lo = i_lo.max(0);
-        let mut hi = i_hi.min(n);
         let folds = self.boundary == SplineBoundary::LinearExtrapolation;
-        if folds && i_lo < 0 {
-            hi = hi.max(1.min(n));
-        }
-        if folds && i_hi > n {
-            lo = lo.min((n - 1).max(0));
-        }
+        let (lo, hi) = folded_range(i_lo, i_hi, n, folds);
         out.first = lo as usize;
         out.len = (hi - lo + 1) as usize;
         for i in i_lo..=i_hi {
             let (s, ds) = spline(self.degree, t_c - i as f64);
             let ds = ds / h;
-            if (0..=n).contains(&i) {
-                let k = (i - lo) as usize;
-                out.w[k] += s;
-                out.dw[k] += ds;
-                continue;
-            }
-            #[cfg(feature = "seeded-bugs")]
-            if crate::seeded::active(crate::seeded::Bug::SplineWithoutBoundary) {
-                continue;
-            }
-            if !folds || n < 1 {
-                continue;
-            }
-            // Node i beyond the grid: k nodes past the edge node e, folded onto e and its
-            // inner neighbour f as u_i = (1 + k) u_e − k u_f.
-            let (e, f, k) = if i < 0 { (0, 1, -i) } else { (n, n - 1, i - n) };
-            let (ke, kf) = ((e - lo) as usize, (f - lo) as usize);
-            let k = k as f64;
-            out.w[ke] += (1.0 + k) * s;
-            out.dw[ke] += (1.0 + k) * ds;
-            out.w[kf] -= k * s;
-            out.dw[kf] -= k * ds;
+            add_folded(out, i, lo, n, folds, s, ds);
         }
         Ok(())
     }
+}
+
+/// The nodes inside the grid that spline nodes `i_lo..=i_hi` reach on a grid whose last node is
+/// `n`, widened (if `folds`) to the two an extrapolated node folds onto.
+pub(super) fn folded_range(i_lo: i64, i_hi: i64, n: i64, folds: bool) -> (i64, i64) {
+    let mut lo = i_lo.max(0);
+    let mut hi = i_hi.min(n);
+    if folds && i_lo < 0 {
+        hi = hi.max(1.min(n));
+    }
+    if folds && i_hi > n {
+        lo = lo.min((n - 1).max(0));
+    }
+    (lo, hi)
+}
+
+/// Add node `i`'s weight `s` and gradient `ds` to `out` (whose first node is `lo`): as they
+/// are inside the grid, else (if `folds`) folded onto the edge node and its inner neighbour
+/// by linear extrapolation (the module documentation), else dropped.
+#[inline]
+pub(super) fn add_folded(out: &mut AxisWeights, i: i64, lo: i64, n: i64, folds: bool, s: f64, ds: f64) {
+    if (0..=n).contains(&i) {
+        let k = (i - lo) as usize;
+        out.w[k] += s;
+        out.dw[k] += ds;
+        return;
+    }
+    #[cfg(feature = "seeded-bugs")]
+    if crate::seeded::active(crate::seeded::Bug::SplineWithoutBoundary) {
+        return;
+    }
+    if !folds || n < 1 {
+        return;
+    }
+    // Node i beyond the grid: k nodes past the edge node e, folded onto e and its inner
+    // neighbour f as u_i = (1 + k) u_e − k u_f.
+    let (e, f, k) = if i < 0 { (0, 1, -i) } else { (n, n - 1, i - n) };
+    let (ke, kf) = ((e - lo) as usize, (f - lo) as usize);
+    let k = k as f64;
+    out.w[ke] += (1.0 + k) * s;
+    out.dw[ke] += (1.0 + k) * ds;
+    out.w[kf] -= k * s;
+    out.dw[kf] -= k * ds;
 }

@@ -29,7 +29,7 @@
 //! through ∂S̄/∂x mapped by ΔF⁻¹ (eq 36) alone, so nothing beyond the weights and their gradient
 //! is needed (no derivative with respect to r).
 
-use super::bspline::{spline, SplineDegree};
+use super::bspline::{add_folded, folded_range, spline, SplineDegree};
 use super::{AxisKernel, AxisWeights, BasisError, GridAxis, MAX_AXIS_NODES};
 
 /// ∫ N(s) ds from −∞ to `t` of the centred uniform spline N of [`spline`] (t in units of h):
@@ -170,38 +170,14 @@ impl AxisKernel for BsplineGimpKernel {
         // The last node; the nodes inside the grid, widened to the two an extrapolated node
         // folds onto (as src/basis/bspline.rs).
         let n = cells as i64;
-        let mut lo = i_lo.max(0);
-        let mut hi = i_hi.min(n);
-        if i_lo < 0 {
-            hi = hi.max(1.min(n));
-        }
-        if i_hi > n {
-            lo = lo.min((n - 1).max(0));
-        }
+        let (lo, hi) = folded_range(i_lo, i_hi, n, true);
         out.first = lo as usize;
         out.len = (hi - lo + 1) as usize;
         for i in i_lo..=i_hi {
             let (a, b) = (t_lo - i as f64, t_hi - i as f64);
             let s = (spline_integral(self.degree, b) - spline_integral(self.degree, a)) / width;
             let ds = (spline(self.degree, b).0 - spline(self.degree, a).0) / (width * h);
-            if (0..=n).contains(&i) {
-                let k = (i - lo) as usize;
-                out.w[k] += s;
-                out.dw[k] += ds;
-                continue;
-            }
-            if n < 1 {
-                continue;
-            }
-            // Node i beyond the grid: k nodes past the edge node e, folded onto e and its inner
-            // neighbour f as u_i = (1 + k) u_e − k u_f.
-            let (e, f, k) = if i < 0 { (0, 1, -i) } else { (n, n - 1, i - n) };
-            let (ke, kf) = ((e - lo) as usize, (f - lo) as usize);
-            let k = k as f64;
-            out.w[ke] += (1.0 + k) * s;
-            out.dw[ke] += (1.0 + k) * ds;
-            out.w[kf] -= k * s;
-            out.dw[kf] -= k * ds;
+            add_folded(out, i, lo, n, true, s, ds);
         }
         Ok(())
     }
