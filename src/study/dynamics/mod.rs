@@ -13,6 +13,7 @@ pub mod records;
 use super::vocabulary::{Checker, Header, NewtonSection};
 use super::{StudyError, Tier};
 use crate::basis::method::Method;
+use crate::material::constitutive::Material;
 use crate::problems::bar::BarSpec;
 use crate::problems::cantilever::CantileverSpec;
 use crate::problems::cantilever_dynamic::DynamicCantileverSpec;
@@ -29,7 +30,6 @@ use std::collections::BTreeSet;
 #[serde(deny_unknown_fields)]
 pub struct BarSection {
     pub length: f64,
-    pub young_modulus: f64,
     pub density: f64,
     /// Peak initial velocity v₀ of the first mode.
     pub velocity: f64,
@@ -50,8 +50,6 @@ pub struct BarSection {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ManufacturedSection {
-    pub young_modulus: f64,
-    pub poisson_ratio: f64,
     /// ρ₀.
     pub density: f64,
     /// Peak amplitude of each field (A of the axis-aligned field, θ₀ of the vortex).
@@ -77,8 +75,6 @@ pub struct ManufacturedSection {
 pub struct CantileverSection {
     pub length: f64,
     pub depth: f64,
-    pub young_modulus: f64,
-    pub poisson_ratio: f64,
     /// P (N), downwards.
     pub load: f64,
     pub density: f64,
@@ -311,6 +307,9 @@ pub struct DynamicStudy {
     pub manufactured: Option<ManufacturedSection>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cantilever: Option<CantileverSection>,
+    /// The material of every case (`[material]`): Hencky elasticity (`linear-elastic`), whose
+    /// closed forms and strain energy the measures take.
+    pub material: crate::study::material::MaterialTable,
     pub newton: NewtonSection,
     pub sweeps: Vec<DynamicSweep>,
     #[serde(default)]
@@ -516,6 +515,7 @@ impl DynamicStudy {
     /// The bar's spec of one case.
     pub fn bar_spec(
         b: &BarSection,
+        material: Material,
         newton: &NewtonSection,
         mass: MassMatrix,
         elements: i64,
@@ -524,7 +524,7 @@ impl DynamicStudy {
     ) -> BarSpec {
         BarSpec {
             length: b.length,
-            young_modulus: b.young_modulus,
+            material,
             density: b.density,
             velocity: b.velocity,
             elements: elements as usize,
@@ -543,6 +543,7 @@ impl DynamicStudy {
     /// cell along each axis, `steps` per T₁.
     pub fn cantilever_spec(
         c: &CantileverSection,
+        material: Material,
         newton: &NewtonSection,
         mass: MassMatrix,
         elements: i64,
@@ -552,8 +553,7 @@ impl DynamicStudy {
         let beam = CantileverSpec {
             length: c.length,
             depth: c.depth,
-            young_modulus: c.young_modulus,
-            poisson_ratio: c.poisson_ratio,
+            material,
             load: c.load,
             element_size: c.depth / elements as f64,
             points_per_cell: ppc as usize,
@@ -588,14 +588,23 @@ impl DynamicStudy {
         ppc: i64,
         steps: i64,
     ) -> Option<CaseSpec> {
+        let m = self.material.material();
         if let Some(c) = &self.cantilever {
             let r = reference?;
-            let spec = Self::cantilever_spec(c, &self.newton, mass, elements, ppc, steps);
+            let spec = Self::cantilever_spec(c, m, &self.newton, mass, elements, ppc, steps);
             return Some(CaseSpec::Cantilever(CantileverCase {
                 spec,
                 reference: ReferenceRun {
                     method: r.method.unwrap_or(method),
-                    spec: Self::cantilever_spec(c, &self.newton, mass, r.elements, ppc, r.steps_per_period),
+                    spec: Self::cantilever_spec(
+                        c,
+                        m,
+                        &self.newton,
+                        mass,
+                        r.elements,
+                        ppc,
+                        r.steps_per_period,
+                    ),
                 },
             }));
         }
@@ -605,7 +614,7 @@ impl DynamicStudy {
                 spec,
                 reference: BarReferenceRun {
                     method: r.method.unwrap_or(method),
-                    spec: Self::bar_spec(b, &self.newton, mass, r.elements, ppc, r.steps_per_period),
+                    spec: Self::bar_spec(b, m, &self.newton, mass, r.elements, ppc, r.steps_per_period),
                 },
             }),
             (spec, _, _) => spec,
@@ -626,6 +635,7 @@ impl DynamicStudy {
         if let Some(b) = &self.bar {
             return Some(CaseSpec::Bar(Self::bar_spec(
                 b,
+                self.material.material(),
                 &self.newton,
                 mass,
                 elements,
@@ -641,8 +651,7 @@ impl DynamicStudy {
                 Field::AxisAligned => m.amplitude.axis_aligned,
                 Field::Vortex => m.amplitude.vortex,
             },
-            young_modulus: m.young_modulus,
-            poisson_ratio: m.poisson_ratio,
+            material: self.material.material(),
             density: m.density,
             cells: elements as usize,
             points_per_cell: ppc as usize,
@@ -772,6 +781,11 @@ impl DynamicStudy {
                 "exactly one of [bar], [manufactured] and [cantilever] must define the problem",
             ));
         }
+        let material = chk.material("material", &self.material)?;
+        let hencky = "the dynamic problems' closed forms and strain energy are Hencky elasticity's";
+        material
+            .require_model(&crate::material::constitutive::LINEAR_ELASTIC, hencky)
+            .map_err(|e| chk.err(e.field, e.value, e.allowed))?;
         // A section's positive fields, and its duration: the period is measured between two
         // downward crossings (`of`), which 1.5 periods contain.
         let timed_section = |fields: &[(&str, f64)], periods: (&str, f64), of: &str| {
@@ -792,7 +806,6 @@ impl DynamicStudy {
                 &[
                     ("cantilever.length", c.length),
                     ("cantilever.depth", c.depth),
-                    ("cantilever.young_modulus", c.young_modulus),
                     ("cantilever.load", c.load),
                     ("cantilever.density", c.density),
                     ("cantilever.grid_below", c.grid_below),
@@ -807,7 +820,6 @@ impl DynamicStudy {
             (Some(b), None) => timed_section(
                 &[
                     ("bar.length", b.length),
-                    ("bar.young_modulus", b.young_modulus),
                     ("bar.density", b.density),
                     ("bar.velocity", b.velocity),
                 ],
@@ -819,7 +831,6 @@ impl DynamicStudy {
                     return Err(chk.err("manufactured.dimension", m.dimension, "must be 2 or 3"));
                 }
                 for (k, v) in [
-                    ("manufactured.young_modulus", m.young_modulus),
                     ("manufactured.density", m.density),
                     ("manufactured.periods", m.periods),
                 ] {
