@@ -1,16 +1,21 @@
 //! Elastic column of §5.1 with iGIMP and MPM: prints top displacement, base F and errors.
-//! `cargo run --release --example column -- [elements] [weight]`
+//! `cargo run --release --example column -- [elements] [weight] [yield stress]`
+use igimp::material::constitutive::Material;
 use igimp::problems::column::{solve_column, ColumnSpec, Method};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let elements = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(256);
     let weight = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(400_000.0);
-    let yield_stress = args.get(3).and_then(|s| s.parse().ok());
+    let (e, nu) = (1e6, 0.0);
+    let material = match args.get(3).and_then(|s| s.parse().ok()) {
+        Some(yield_stress) => Material::von_mises(e, nu, yield_stress),
+        None => Material::linear_elastic(e, nu),
+    };
     let spec = ColumnSpec {
         elements,
         weight,
-        yield_stress,
+        material,
         ..ColumnSpec::default()
     };
     let exact = spec.analytical();

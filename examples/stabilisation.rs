@@ -5,6 +5,7 @@
 //! compaction: h ppc treatment [yield]   (treatment: none | tie | ghost:<gamma>[:all])
 //! cantilever: treatment [update]        (update: stretch | f-diagonal)
 use igimp::discretise::ghost::{GhostFaces, GhostSettings};
+use igimp::material::constitutive::Material;
 use igimp::mpm::{DomainUpdate, WeakNodeTreatment};
 use igimp::problems::{cantilever, compaction};
 
@@ -38,7 +39,10 @@ fn main() {
             let spec = compaction::CompactionSpec {
                 element_size: args[1].parse().unwrap(),
                 points_per_cell: args[2].parse().unwrap(),
-                yield_stress: args.get(4).and_then(|s| s.parse().ok()),
+                material: match args.get(4).and_then(|s| s.parse().ok()) {
+                    Some(yield_stress) => Material::von_mises(1e5, 0.3, yield_stress),
+                    None => Material::linear_elastic(1e5, 0.3),
+                },
                 weak_node_tolerance: tol,
                 weak_node_treatment: tr,
                 ghost,

@@ -154,7 +154,7 @@ pub mod prelude {
     pub use crate::basis::Basis;
     pub use crate::discretise::ghost::GhostSettings;
     pub use crate::fem::{HexElement, HexMesh, LineElement, LineMesh, PlaneMesh, QuadElement};
-    pub use crate::material::constitutive::{ConstitutiveModel, LinearElastic, VonMises};
+    pub use crate::material::constitutive::{ConstitutiveModel, LinearElastic, Material, VonMises};
     pub use crate::mesh::grid::Grid;
     pub use crate::mpm::particles::MaterialPoints;
     pub use crate::mpm::{DomainUpdate, Loads, MpmBuilder, MpmSettings, MpmSolver};

@@ -165,6 +165,7 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
                 gauss.push(e, *xi, pos, w * super::mesh::det_inverse(&jac).0, density);
             }
         }
+        gauss.initialise_material(model.as_ref());
         let mut core = UlCore::new(model, fixed.clone());
         core.work.matrix.set_solver(settings.linear_solver);
         Ok(Self {

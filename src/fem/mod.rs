@@ -160,6 +160,7 @@ impl LineFem {
                 gauss.push(e, xi, pos, w * jac, density);
             }
         }
+        gauss.initialise_material(model.as_ref());
         let fixed_dofs = fixed.iter().map(|&n| (n, 0)).collect();
         Ok(Self {
             mesh0: mesh.clone(),
@@ -171,6 +172,11 @@ impl LineFem {
             rule,
             core: UlCore::new(model, fixed_dofs),
         })
+    }
+
+    /// The constitutive model.
+    pub fn model(&self) -> &dyn ConstitutiveModel {
+        self.core.model.as_ref()
     }
 
     /// The Gauss rule on [−1, 1].

@@ -79,6 +79,13 @@ impl<X> GaussPoints<X> {
         self.mass.push(density * volume0);
         self.state.push(PointState::undeformed(volume0));
     }
+    /// Give every point that holds no internal variables `model`'s initial ones
+    /// ([`crate::material::constitutive::MaterialState::initialise`]).
+    pub fn initialise_material(&mut self, model: &dyn ConstitutiveModel) {
+        for s in &mut self.state {
+            s.material.initialise(model);
+        }
+    }
     /// Reserve room for `n` more points.
     pub fn reserve(&mut self, n: usize) {
         self.element.reserve(n);

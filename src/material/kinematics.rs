@@ -272,7 +272,7 @@ pub struct PointTrial<const D: usize> {
     pub volume: f64,
     /// Inverse of the in-plane block of ΔF, mapping ∂/∂X̃ to ∂/∂x (eqs 35–36).
     pub delta_f_inv: SMatrix<f64, D, D>,
-    /// Constitutive response (τ, ε^e, plastic multiplier).
+    /// Constitutive response (τ, ε^e, internal variables).
     pub response: MaterialResponse,
     /// Eigenvalues of the trial b^e.
     pub b_trial_eigenvalues: Vector3<f64>,
@@ -409,7 +409,7 @@ impl<const D: usize> PointTrial<D> {
             material: MaterialState {
                 eps_e: self.response.eps_e,
                 b_e: left_cauchy_green_from_strain(&self.response.eps_e),
-                plastic_multiplier: self.response.plastic_multiplier,
+                internal: self.response.internal,
             },
         }
     }

@@ -122,6 +122,7 @@ impl<const D: usize> MpmSolver<D> {
         }
         let family = settings.basis.shared::<D>();
         let mut points = points;
+        points.initialise_material(model.as_ref());
         if family.needs_corners() {
             points.track_corners();
         }

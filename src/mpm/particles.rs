@@ -35,6 +35,14 @@ pub struct MaterialPoints<const D: usize> {
 }
 
 impl<const D: usize> MaterialPoints<D> {
+    /// Give every point that holds no internal variables `model`'s initial ones
+    /// ([`crate::material::constitutive::MaterialState::initialise`]).
+    pub fn initialise_material(&mut self, model: &dyn crate::material::constitutive::ConstitutiveModel) {
+        for s in &mut self.state {
+            s.material.initialise(model);
+        }
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         self.position.len()

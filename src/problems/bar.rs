@@ -5,7 +5,8 @@
 //! v(X, 0) = v₀ sin(πX / 2L),   u(X, t) = (v₀/ω) sin(πX / 2L) sin(ωt),   ω = πc / 2L,
 //! ```
 //!
-//! c = √(E/ρ) (ν = 0, so the uniaxial-strain modulus is E), period T = 4L/c. It is solved by
+//! c = √(M/ρ) with the uniaxial-strain modulus M = λ + 2μ (E at ν = 0, the studies'), period
+//! T = 4L/c. It is solved by
 //! Newmark time stepping ([`crate::solver::dynamics`]) with the material point methods in 1D and the
 //! updated-Lagrangian line elements as comparators. The
 //! measures are the top point's displacement history, the period measured from its zero
@@ -16,7 +17,7 @@
 use crate::basis::method::Method;
 use crate::basis::DomainUpdate;
 use crate::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
-use crate::material::constitutive::LinearElastic;
+use crate::material::constitutive::{lame, ConstitutiveModel, Material, LINEAR_ELASTIC};
 use crate::material::kinematics::{log_strain, PointState};
 use crate::mesh::grid::Grid;
 use crate::mpm::particles::MaterialPoints;
@@ -34,7 +35,9 @@ use std::f64::consts::PI;
 #[serde(deny_unknown_fields)]
 pub struct BarSpec {
     pub length: f64,
-    pub young_modulus: f64,
+    /// Hencky elasticity (`linear-elastic`): the closed form and the strain energy are its.
+    /// The bar is in uniaxial strain, so its modulus is M = λ + 2μ, E at the study's ν = 0.
+    pub material: Material,
     pub density: f64,
     /// Peak initial velocity v₀ (at the free end).
     pub velocity: f64,
@@ -61,7 +64,7 @@ impl Default for BarSpec {
     fn default() -> Self {
         BarSpec {
             length: 1.0,
-            young_modulus: 100.0,
+            material: Material::linear_elastic(100.0, 0.0),
             density: 1.0,
             velocity: 1e-3,
             elements: 16,
@@ -125,7 +128,9 @@ impl LineField {
 impl BarSpec {
     pub fn validate(&self) -> Result<(), InputError> {
         require_positive("bar.length", self.length)?;
-        require_positive("bar.young_modulus", self.young_modulus)?;
+        let hencky = "the bar's closed form (uniaxial strain, modulus λ + 2μ) and strain energy are Hencky elasticity's";
+        self.material.require_model(&LINEAR_ELASTIC, hencky)?;
+        self.model()?;
         require_positive("bar.density", self.density)?;
         crate::solver::error::require_finite("bar.velocity", self.velocity)?;
         require_count("bar.elements", self.elements, 1)?;
@@ -143,9 +148,22 @@ impl BarSpec {
         self.newmark().validate()
     }
 
-    /// Wave speed c = √(E/ρ).
+    /// The constitutive model, built from [`Self::material`].
+    pub fn model(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
+        self.material.build()
+    }
+
+    /// The bar's modulus M = λ + 2μ (uniaxial strain; E when ν = 0), NaN for a material
+    /// without E or ν (validation refuses it).
+    pub fn modulus(&self) -> f64 {
+        let get = |k| self.material.get(k).unwrap_or(f64::NAN);
+        let (lambda, mu) = lame(get("young_modulus"), get("poisson_ratio"));
+        lambda + 2.0 * mu
+    }
+
+    /// Wave speed c = √(M/ρ).
     pub fn wave_speed(&self) -> f64 {
-        (self.young_modulus / self.density).sqrt()
+        (self.modulus() / self.density).sqrt()
     }
 
     /// T = 4L/c.
@@ -239,7 +257,7 @@ impl BarSpec {
             gravity: SVector::zeros(),
             point_loads: vec![],
         };
-        let model = Box::new(LinearElastic::try_new(self.young_modulus, 0.0)?);
+        let model = self.model()?;
         MpmSolver::try_new(grid, points, model, fixed, loads, settings)
     }
 }
@@ -310,7 +328,7 @@ pub fn fem_solver(spec: &BarSpec, element: LineElement) -> Result<LineFem, Input
         gravity: 0.0,
         nodal_forces: vec![],
     };
-    let model = Box::new(LinearElastic::try_new(spec.young_modulus, 0.0)?);
+    let model = spec.model()?;
     let velocity: Vec<f64> = mesh
         .nodes
         .iter()

@@ -68,6 +68,7 @@ pub struct DynamicCantileverOutcome {
 
 impl DynamicCantileverSpec {
     pub fn validate(&self) -> Result<(), InputError> {
+        self.beam.elastic_constants()?;
         require_positive("cantilever.density", self.density)?;
         require_positive("cantilever.periods", self.periods)?;
         require_count("cantilever.steps_per_period", self.steps_per_period, 1)?;
@@ -95,10 +96,11 @@ impl DynamicCantileverSpec {
         }
     }
 
-    /// T₁ (module docs).
+    /// T₁ (module docs); NaN for a material without E or ν (validation refuses it).
     pub fn period(&self) -> f64 {
         let b = &self.beam;
-        let ei = b.young_modulus * b.depth.powi(3) / (12.0 * (1.0 - b.poisson_ratio.powi(2)));
+        let (e, nu) = b.elastic_constants().unwrap_or((f64::NAN, f64::NAN));
+        let ei = e * b.depth.powi(3) / (12.0 * (1.0 - nu.powi(2)));
         let omega = FIRST_MODE_ROOT.powi(2) * (ei / (self.density * b.depth * b.length.powi(4))).sqrt();
         2.0 * PI / omega
     }

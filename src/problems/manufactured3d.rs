@@ -18,7 +18,6 @@ use super::manufactured::{
 };
 use crate::basis::method::Method;
 use crate::fem::{ElementFamily, FemLoads, HexElement, HexMesh, PlaneFemSettings, SolidFem};
-use crate::material::constitutive::{lame, LinearElastic};
 use crate::mesh::grid::Grid;
 use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{Loads, MpmSolver};
@@ -56,7 +55,7 @@ pub struct Exact3 {
 
 impl Exact3 {
     pub fn of(spec: &ManufacturedSpec) -> Self {
-        let (lambda, mu) = lame(spec.young_modulus, spec.poisson_ratio);
+        let (lambda, mu) = spec.lame();
         Exact3 {
             field: spec.field,
             amplitude: spec.amplitude,
@@ -246,7 +245,7 @@ pub fn mpm_solver_3d(spec: &ManufacturedSpec, method: Method) -> Result<MpmSolve
         gravity: V3::zeros(),
         point_loads,
     };
-    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    let model = spec.model()?;
     MpmSolver::try_new(grid, points, model, fixed, loads, settings)
 }
 
@@ -263,7 +262,7 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
         ));
     }
     let exact = Exact3::of(spec);
-    let model = || LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio).map(Box::new);
+    let model = || spec.model();
     let (steps, failure, values) = match method {
         Method::MaterialPoint(_) => {
             let mut solver = mpm_solver_3d(spec, method)?;

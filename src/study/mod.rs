@@ -23,6 +23,7 @@ pub mod engine;
 pub mod kinds;
 pub mod locate;
 pub mod manufactured;
+pub mod material;
 pub mod methods;
 pub mod render;
 pub mod replace;

@@ -16,6 +16,7 @@
 //! collection format.
 
 use crate::fem::{ElementFamily, ElementMesh, LineElement, LineMesh};
+use crate::material::constitutive::InternalVariable;
 use crate::material::kinematics::PointState;
 use crate::mesh::grid::Grid;
 use crate::mpm::particles::MaterialPoints;
@@ -254,29 +255,32 @@ pub fn write_pvd(path: &Path, entries: &[PvdEntry]) -> std::io::Result<()> {
 }
 
 /// Point arrays shared by material and Gauss points: volume, Cauchy stress σ, Kirchhoff
-/// stress τ, deformation gradient F (row-major 9 components), plastic multiplier.
-fn add_state_arrays(g: &mut UnstructuredGrid, states: &[PointState]) {
+/// stress τ, deformation gradient F (row-major 9 components), and one array per internal
+/// variable the model declares (`internal`, by name: von Mises' `plastic_multiplier`).
+fn add_state_arrays(g: &mut UnstructuredGrid, states: &[PointState], internal: &[InternalVariable]) {
     g.add_point_scalars("volume", states.iter().map(|s| s.volume));
     g.add_point_rows("cauchy_stress", states.iter().map(|s| tensor9(&s.cauchy())));
     g.add_point_rows("kirchhoff_stress", states.iter().map(|s| tensor9(&s.tau)));
     g.add_point_rows("deformation_gradient", states.iter().map(|s| tensor9(&s.f)));
-    g.add_point_scalars(
-        "plastic_multiplier",
-        states.iter().map(|s| s.material.plastic_multiplier),
-    );
+    for (i, v) in internal.iter().enumerate() {
+        g.add_point_scalars(v.name, states.iter().map(|s| s.material.internal.get(i)));
+    }
 }
 
 /// Material points as vertices at their current positions, with `position0`,
 /// `displacement`, `domain_extent` (current domain lengths l_p = 2 × half-length per axis),
 /// `volume0`, and the state arrays (`volume`, `cauchy_stress`, `kirchhoff_stress`,
-/// `deformation_gradient`, `plastic_multiplier`).
-pub fn material_points<const D: usize>(pts: &MaterialPoints<D>) -> UnstructuredGrid {
+/// `deformation_gradient`, then the model's internal variables `internal`).
+pub fn material_points<const D: usize>(
+    pts: &MaterialPoints<D>,
+    internal: &[InternalVariable],
+) -> UnstructuredGrid {
     let mut g = UnstructuredGrid::vertices(pts.position.iter().map(pad3).collect());
     g.add_point_rows("position0", pts.position0.iter().map(pad3));
     g.add_point_rows("displacement", (0..pts.len()).map(|p| pad3(&pts.displacement(p))));
     g.add_point_rows("domain_extent", pts.half_length.iter().map(|h| pad3(&(h * 2.0))));
     g.add_point_scalars("volume0", pts.volume0.iter().copied());
-    add_state_arrays(&mut g, &pts.state);
+    add_state_arrays(&mut g, &pts.state, internal);
     g
 }
 
@@ -287,6 +291,7 @@ pub fn gauss_points(
     position0: &[[f64; 3]],
     volume0: &[f64],
     states: &[PointState],
+    internal: &[InternalVariable],
 ) -> UnstructuredGrid {
     let mut g = UnstructuredGrid::vertices(position.to_vec());
     g.add_point_rows("position0", position0.iter().copied());
@@ -298,7 +303,7 @@ pub fn gauss_points(
             .map(|(x, x0)| [x[0] - x0[0], x[1] - x0[1], x[2] - x0[2]]),
     );
     g.add_point_scalars("volume0", volume0.iter().copied());
-    add_state_arrays(&mut g, states);
+    add_state_arrays(&mut g, states, internal);
     g
 }
 

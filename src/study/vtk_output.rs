@@ -96,14 +96,14 @@ impl ColumnVtkWriter {
                     .map(|p| pad3(&nalgebra::SVector::<f64, 1>::new(s.gauss_point_map(p).0)))
                     .collect();
                 let x0: Vec<[f64; 3]> = g.position0.iter().map(|&z| [z, 0.0, 0.0]).collect();
-                let points = vtk::gauss_points(&x, &x0, &g.volume0, &g.state);
+                let points = vtk::gauss_points(&x, &x0, &g.volume0, &g.state, s.model().internal_variables());
                 (points, vtk::line_mesh(&s.mesh, &s.mesh0))
             }
             ColumnState::Fem3(s) => {
                 let g = &s.gauss;
                 let x: Vec<[f64; 3]> = (0..g.len()).map(|p| pad3(&s.gauss_point_position(p))).collect();
                 let x0: Vec<[f64; 3]> = g.position0.iter().map(pad3).collect();
-                let points = vtk::gauss_points(&x, &x0, &g.volume0, &g.state);
+                let points = vtk::gauss_points(&x, &x0, &g.volume0, &g.state, s.model().internal_variables());
                 (points, vtk::element_mesh(&s.mesh, &s.mesh0))
             }
         };
@@ -139,7 +139,10 @@ impl ColumnVtkWriter {
             &s.grid,
             &[("displacement_increment", inc), ("displacement", total)],
         );
-        (vtk::material_points(&s.points), grid)
+        (
+            vtk::material_points(&s.points, s.model().internal_variables()),
+            grid,
+        )
     }
 
     fn write(&mut self, step: usize, points: &UnstructuredGrid, grid: &UnstructuredGrid) {

@@ -79,8 +79,7 @@ fn a_cantilever_sweep_names_a_usable_reference() {
         ),
         "sweeps[1].reference.steps_per_period",
     );
-    let bar =
-        "[bar]\nlength = 1.0\nyoung_modulus = 100.0\ndensity = 1.0\nvelocity = 1.0e-3\nperiods = 3.0\n\n";
+    let bar = "[bar]\nlength = 1.0\ndensity = 1.0\nvelocity = 1.0e-3\nperiods = 3.0\n\n";
     refused(
         text.replacen("[cantilever]", &format!("{bar}[cantilever]"), 1),
         "exactly one of [bar], [manufactured] and [cantilever]",

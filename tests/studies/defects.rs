@@ -202,7 +202,7 @@ fn every_file_is_validated_before_any_is_solved() {
         out.as_os_str(),
     ]);
     assert!(
-        !o.status.success() && err.contains("column.young_modulus"),
+        !o.status.success() && err.contains("material.young_modulus"),
         "{err}"
     );
     assert!(
@@ -245,9 +245,11 @@ report_file = "table.md"
 load_steps = 2
 [column]
 length = 50.0
+density = 80.0
+[material]
+model = "linear-elastic"
 young_modulus = 1.0e300
 poisson_ratio = 0.0
-density = 80.0
 [newton]
 tolerance = 1.0e-9
 max_iterations = 30
@@ -285,6 +287,7 @@ problem = "manufactured"
 report_file = "report.md"
 load_steps = 4
 [material]
+model = "linear-elastic"
 young_modulus = {e}
 poisson_ratio = 0.3
 [amplitude]
@@ -349,9 +352,11 @@ report_file = "table.md"
 load_steps = 2
 [column]
 length = 50.0
+density = 80.0
+[material]
+model = "linear-elastic"
 young_modulus = 1.0e6
 poisson_ratio = 0.0
-density = 80.0
 [newton]
 tolerance = 1.0e-9
 max_iterations = 30

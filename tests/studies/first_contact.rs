@@ -169,7 +169,8 @@ fn failing_column(declared: bool) -> String {
     let mut t = String::from(
         "schema = 1\nname = \"tiny\"\nsummary = \"every case fails\"\nproblem = \"column\"\n\
          report_file = \"table1.md\"\nload_steps = 2\n\n[column]\nlength = 50.0\n\
-         young_modulus = 1.0e6\npoisson_ratio = 0.0\ndensity = 80.0\n\n[newton]\n\
+         density = 80.0\n\n[material]\nmodel = \"linear-elastic\"\nyoung_modulus = 1.0e6\n\
+         poisson_ratio = 0.0\n\n[newton]\n\
          tolerance = 1.0e-9\nmax_iterations = 1\n\n[[sweeps]]\nid = \"s\"\ntitle = \"t\"\n\
          methods = [\"igimp\"]\nweights = [40000.0]\nelements = [4, 8]\npoints_per_cell = [2]\n",
     );
@@ -331,8 +332,8 @@ fn a_mesh_over_the_size_cap_is_refused_with_its_estimate() {
 fn a_case_over_the_size_cap_is_recorded_and_the_others_run() {
     let text = "schema = 1\nname = \"huge\"\nsummary = \"one case over the size cap\"\n\
         problem = \"compaction\"\nreport_file = \"report.md\"\n\n[block]\nhalf_width = 4.0\n\
-        height = 8.0\ngrid_extent = [10.0, 10.0]\nyoung_modulus = 1.0e5\npoisson_ratio = 0.3\n\
-        weight = 4.0e5\nload_steps = 2\n\n[newton]\ntolerance = 1.0e-9\nmax_iterations = 30\n\n\
+        height = 8.0\ngrid_extent = [10.0, 10.0]\nweight = 4.0e5\nload_steps = 2\n\n\
+        [material]\nmodel = \"linear-elastic\"\nyoung_modulus = 1.0e5\npoisson_ratio = 0.3\n\n[newton]\ntolerance = 1.0e-9\nmax_iterations = 30\n\n\
         [weak_nodes]\ntolerance = 0.0\ntreatment = \"tie\"\n\n[ghost]\ngamma = 0.0\n\
         source = \"none\"\n\n[[sweeps]]\nid = \"s\"\ntitle = \"t\"\nmethods = [\"fem-q4\"]\n\
         element_sizes = [1.0e-4, 2.0]\npoints_per_cell = [2]\n\n[reference]\nfem_sweep = \"s\"\n\
@@ -399,4 +400,63 @@ fn a_missing_top_level_key_says_where_it_belongs() {
         "{err}"
     );
     assert!(!err.contains("line 1, column 1"), "{err}");
+}
+
+/// The `[material]` section: an unknown model lists the known ones, a missing or an unknown
+/// parameter names its key, a sweep naming no `[materials.<name>]` table names its key, and a
+/// kind that takes one model only says which, each with the file's line.
+#[test]
+fn material_errors_name_the_model_or_parameter_key_and_line() {
+    let column = repo_study("column");
+    let t = set(&column, "model", "\"von-mieses\"");
+    rejected(
+        &t,
+        "material.model",
+        "linear-elastic, von-mises",
+        Some(line_of(&t, "model =")),
+    );
+    let t = column.replacen("poisson_ratio = 0.0\n", "", 1);
+    rejected(
+        &t,
+        "material.poisson_ratio",
+        "the model linear-elastic needs it",
+        Some(line_of(&t, "[material]")),
+    );
+    let t = column.replacen(
+        "model = \"linear-elastic\"",
+        "model = \"linear-elastic\"\nyield_stress = 3.0e4",
+        1,
+    );
+    rejected(
+        &t,
+        "material.yield_stress",
+        "is not a parameter of the model linear-elastic",
+        Some(line_of(&t, "yield_stress =")),
+    );
+    let compaction = repo_study("compaction");
+    let t = compaction.replacen("material = \"von-mises\"", "material = \"plastic\"", 1);
+    rejected(
+        &t,
+        "sweeps[1].material",
+        "it has: von-mises",
+        Some(line_of(&t, "material = \"plastic\"")),
+    );
+    let t = compaction.replacen("yield_stress = 1.2e4", "", 1);
+    rejected(
+        &t,
+        "materials.von-mises.yield_stress",
+        "the model von-mises needs it",
+        Some(line_of(&t, "[materials.von-mises]")),
+    );
+    let t = set(
+        &repo_study("manufactured"),
+        "model",
+        "\"von-mises\"\nyield_stress = 1.0",
+    );
+    rejected(
+        &t,
+        "material.model",
+        "must be \"linear-elastic\"",
+        Some(line_of(&t, "model =")),
+    );
 }

@@ -24,9 +24,11 @@ report_file = "table.md"
 load_steps = 8
 [column]
 length = 50.0
+density = 80.0
+[material]
+model = "linear-elastic"
 young_modulus = 1.0e6
 poisson_ratio = 0.0
-density = 80.0
 [newton]
 tolerance = 1.0e-9
 max_iterations = 30

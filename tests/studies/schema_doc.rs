@@ -2,7 +2,8 @@
 //! drift from it: every whole study file shown in a `toml` block of that page or of the
 //! top-level README is accepted by the `study` binary's parser and validator (and its quick
 //! tier runs with every check passing), and every key path a committed `studies/*.toml` uses
-//! is documented in the schema table of its kind (a new key without a row fails).
+//! is documented in the schema table of its kind (a new key without a row fails), and every
+//! model of the material registry is in the Materials table with its parameters and units.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -166,6 +167,12 @@ fn every_key_of_the_committed_study_files_is_documented_for_its_kind() {
         let kind = section(&md, &format!("## `problem = \"{problem}\"`"));
         let mut paths = vec![];
         key_paths(&table, "", &mut paths);
+        // A named material's key is documented once, as `materials.<name>.<key>`.
+        for p in &mut paths {
+            if let Some((_, key)) = p.strip_prefix("materials.").and_then(|r| r.split_once('.')) {
+                *p = format!("materials.<name>.{key}");
+            }
+        }
         paths.sort();
         paths.dedup();
         for p in paths {
@@ -181,5 +188,41 @@ fn every_key_of_the_committed_study_files_is_documented_for_its_kind() {
         "keys used by committed study files but not in the schema table of their kind in \
          studies/README.md:\n{}",
         missing.join("\n")
+    );
+}
+
+/// The Materials table lists every built-in model of the registry with each of its parameters
+/// and units, and nothing else, so that the page cannot drift from the code.
+#[test]
+fn the_materials_table_is_the_registry() {
+    let md = read("studies/README.md");
+    let table = section(&md, "## Materials");
+    let rows: Vec<Vec<String>> = table
+        .lines()
+        .filter(|l| l.starts_with("| `"))
+        .map(|l| {
+            l.trim_matches('|')
+                .split('|')
+                .map(|c| c.trim().to_string())
+                .collect()
+        })
+        .collect();
+    let mut expected = vec![];
+    for entry in igimp::material::constitutive::registry::BUILT_IN {
+        for p in entry.parameters {
+            expected.push((
+                format!("`{}`", entry.name),
+                format!("`{}`", p.name),
+                p.unit.to_string(),
+            ));
+        }
+    }
+    let documented: Vec<(String, String, String)> = rows
+        .iter()
+        .map(|r| (r[0].clone(), r[1].clone(), r[2].clone()))
+        .collect();
+    assert_eq!(
+        documented, expected,
+        "studies/README.md's Materials table against the registry"
     );
 }

@@ -373,9 +373,11 @@ report_file = "table.md"
 load_steps = 20
 [column]
 length = 50.0
+density = 80.0
+[material]
+model = "linear-elastic"
 young_modulus = 1.0e6
 poisson_ratio = 0.0
-density = 80.0
 [newton]
 tolerance = 1.0e-9
 max_iterations = 30
@@ -428,7 +430,7 @@ measure = "stress_error"
 
 /// The plastic column study in its quick tier: every expected rate (σzz, σxx,
 /// linear FEM) lies in its band from `studies/column-plastic.toml`, iGIMP stays below linear
-/// FEM, the point files carry σxx, and the yield height of the finest iGIMP case is within
+/// FEM, the point files carry σxx and the plastic multiplier, and the yield height of the finest iGIMP case is within
 /// 0.25 element of the analytical (Kirchhoff-criterion) value — and not the paper's formula.
 #[test]
 fn plastic_column_quick_tier_meets_its_bands_and_yield_height() {
@@ -460,7 +462,16 @@ fn plastic_column_quick_tier_meets_its_bands_and_yield_height() {
         .unwrap();
     let csv =
         std::fs::read_to_string(study_dir.join(igimp::study::column::kind::points_file(&finest.id))).unwrap();
-    assert!(csv.starts_with("z0,z,volume0,sigma_zz,f_zz,sigma_xx\n"));
+    // σxx, then von Mises' internal variable: yielded (> 0) at the base, 0 at the top.
+    assert!(csv.starts_with("z0,z,volume0,sigma_zz,f_zz,sigma_xx,plastic_multiplier\n"));
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let lowest = rows.iter().min_by(|a, b| a[0].total_cmp(&b[0])).unwrap();
+    let highest = rows.iter().max_by(|a, b| a[0].total_cmp(&b[0])).unwrap();
+    assert!(lowest[6] > 0.0 && highest[6] == 0.0, "{lowest:?} {highest:?}");
     let zy = finest.yield_height.expect("yield height");
     let h = 50.0 / finest.elements as f64;
     assert!((zy - 46.135795).abs() < 0.25 * h, "yield height {zy}");

@@ -25,9 +25,11 @@ report_file = "table.md"
 load_steps = 4
 [column]
 length = 50.0
+density = 80.0
+[material]
+model = "von-mises"
 young_modulus = 1.0e6
 poisson_ratio = 0.0
-density = 80.0
 yield_stress = 20000.0
 [newton]
 tolerance = 1.0e-9
@@ -51,9 +53,11 @@ report_file = "table.md"
 load_steps = 20
 [column]
 length = 50.0
+density = 80.0
+[material]
+model = "linear-elastic"
 young_modulus = 1.0e6
 poisson_ratio = 0.0
-density = 80.0
 [newton]
 tolerance = 1.0e-9
 max_iterations = 30
@@ -191,12 +195,13 @@ fn vtk_output_read_by_meshio_matches_results_json_and_point_files() {
         let tau = column(pts, "kirchhoff_stress", 0);
         let lam = column(pts, "plastic_multiplier", 0);
         assert_eq!(x.len(), csv.len());
-        // CSV columns: z0, z, volume0, sigma_zz, f_zz, sigma_xx (shortest round-trip text in
-        // both files, so equality is exact).
+        // CSV columns: z0, z, volume0, sigma_zz, f_zz, sigma_xx, then the material's internal
+        // variable plastic_multiplier, as the VTK array of that name (shortest round-trip text
+        // in both files, so equality is exact).
         for (p, row) in csv.iter().enumerate() {
             assert_eq!(
-                [z0[p], x[p], v0[p], s_zz[p], f_zz[p], s_xx[p]],
-                row[..6],
+                [z0[p], x[p], v0[p], s_zz[p], f_zz[p], s_xx[p], lam[p]],
+                row[..7],
                 "{} point {p}",
                 case.id
             );

@@ -2,6 +2,7 @@
 //! the MPM-vs-GIMP stress error of Figure 8, and input validation.
 
 use igimp::basis::Basis;
+use igimp::material::constitutive::Material;
 use igimp::problems::column::{f_from_cauchy_stress, solve_column, ColumnSpec, Method};
 use igimp::solver::load_stepping::LoadStepping;
 use igimp::solver::newton::{check_quadratic, NewtonSettings};
@@ -146,42 +147,42 @@ fn bad_column_input_names_the_field() {
     let cases: Vec<(ColumnSpec, &str)> = vec![
         (
             ColumnSpec {
-                young_modulus: 0.0,
+                material: Material::linear_elastic(0.0, 0.0),
                 ..Default::default()
             },
             "young_modulus",
         ),
         (
             ColumnSpec {
-                young_modulus: -1.0,
+                material: Material::linear_elastic(-1.0, 0.0),
                 ..Default::default()
             },
             "young_modulus",
         ),
         (
             ColumnSpec {
-                young_modulus: f64::NAN,
+                material: Material::linear_elastic(f64::NAN, 0.0),
                 ..Default::default()
             },
             "young_modulus",
         ),
         (
             ColumnSpec {
-                poisson_ratio: 0.5,
+                material: Material::linear_elastic(1e6, 0.5),
                 ..Default::default()
             },
             "poisson_ratio",
         ),
         (
             ColumnSpec {
-                poisson_ratio: -1.0,
+                material: Material::linear_elastic(1e6, -1.0),
                 ..Default::default()
             },
             "poisson_ratio",
         ),
         (
             ColumnSpec {
-                poisson_ratio: f64::INFINITY,
+                material: Material::linear_elastic(1e6, f64::INFINITY),
                 ..Default::default()
             },
             "poisson_ratio",

@@ -3,6 +3,7 @@
 //! recorded rather than panicking.
 
 use igimp::discretise::ghost::{GhostFaces, GhostSettings};
+use igimp::material::constitutive::Material;
 use igimp::problems::compaction::{solve_mpm, CompactionSpec};
 use igimp::solver::newton::{check_quadratic, ResidualNorm};
 
@@ -80,7 +81,7 @@ fn paper_table3_plastic_newton_reaches_quadratic_convergence() {
     // The compaction study's plastic treatment: the ghost penalty on every face, γ = 0.1
     // (studies/compaction.toml, [ghost] plastic).
     let spec = CompactionSpec {
-        yield_stress: Some(1.2e4),
+        material: Material::von_mises(1e5, 0.3, 1.2e4),
         ghost: GhostSettings {
             gamma: 0.1,
             faces: GhostFaces::All,
@@ -197,7 +198,7 @@ fn bad_compaction_input_names_the_field() {
         ),
         (
             CompactionSpec {
-                poisson_ratio: 0.7,
+                material: Material::linear_elastic(1e5, 0.7),
                 ..Default::default()
             },
             "poisson_ratio",
@@ -218,7 +219,7 @@ fn bad_compaction_input_names_the_field() {
         ),
         (
             CompactionSpec {
-                yield_stress: Some(0.0),
+                material: Material::von_mises(1e5, 0.3, 0.0),
                 ..Default::default()
             },
             "yield_stress",

@@ -5,6 +5,7 @@
 use igimp::basis::method::Method;
 use igimp::basis::Basis;
 use igimp::discretise::assembly::LoadStepSystem;
+use igimp::material::constitutive::Material;
 use igimp::mpm::MpmSolver;
 use igimp::problems::bar::{self, BarSpec};
 use igimp::solver::dynamics::{MassMatrix, Newmark};
@@ -230,7 +231,7 @@ fn effective_tangent_matches_central_differences_2d_and_3d() {
                 ..CompactionSpec::default()
             };
             let mut s2 = spec.mpm_solver().unwrap();
-            made_dynamic(&mut s2, spec.element_size, spec.young_modulus);
+            made_dynamic(&mut s2, spec.element_size, spec.model().unwrap().young_modulus());
             s2.settings.dynamics.as_mut().unwrap().mass = mass;
             for _ in 0..3 {
                 s2.step().unwrap();
@@ -244,11 +245,11 @@ fn effective_tangent_matches_central_differences_2d_and_3d() {
                 elements: 4,
                 weight: 4e4,
                 load_steps: 10,
-                poisson_ratio: 0.3,
+                material: Material::linear_elastic(1e6, 0.3),
                 ..ColumnSpec::default()
             };
             let mut s3 = col.mpm_solver_3d(basis).unwrap();
-            made_dynamic(&mut s3, col.length / 4.0, col.young_modulus);
+            made_dynamic(&mut s3, col.length / 4.0, col.model().unwrap().young_modulus());
             s3.settings.dynamics.as_mut().unwrap().mass = mass;
             for _ in 0..3 {
                 s3.step().unwrap();
@@ -632,7 +633,7 @@ fn generalized_alpha_tangent_and_order_in_the_solvers() {
         ..CompactionSpec::default()
     };
     let mut s2 = spec.mpm_solver().unwrap();
-    made_dynamic(&mut s2, spec.element_size, spec.young_modulus);
+    made_dynamic(&mut s2, spec.element_size, spec.model().unwrap().young_modulus());
     s2.settings.dynamics.as_mut().unwrap().rho_infinity = Some(0.8);
     for _ in 0..3 {
         s2.step().unwrap();

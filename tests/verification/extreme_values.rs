@@ -309,6 +309,58 @@ fn extreme_values_in_dynamics_studies_are_rejected_or_solved_and_measured() {
     probe_kind("dynamics");
 }
 
+/// Every `[material]` and `[materials.<name>]` table of every committed study file: an
+/// unknown model, and each parameter left out, are rejected at load by an error naming the
+/// table's key (`material.model`, `material.poisson_ratio`) with its line, never a panic.
+#[test]
+fn every_material_table_rejects_an_unknown_model_and_a_missing_parameter() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies");
+    let tmp = tempfile::tempdir().unwrap();
+    let mut probed = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_none_or(|x| x != "toml") {
+            continue;
+        }
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        let doc: Value = std::fs::read_to_string(&p).unwrap().parse().unwrap();
+        let mut tables = vec![("material".to_string(), doc["material"].clone())];
+        if let Some(named) = doc.get("materials").and_then(|m| m.as_table()) {
+            tables.extend(named.iter().map(|(k, t)| (format!("materials.{k}"), t.clone())));
+        }
+        for (path, table) in tables {
+            let segs: Vec<Seg> = path.split('.').map(|k| Seg::Key(k.to_string())).collect();
+            let mut edits: Vec<(String, Value)> = vec![];
+            let mut unknown = table.clone();
+            unknown["model"] = Value::String("no-such-model".into());
+            edits.push((format!("{path}.model"), unknown));
+            for key in table.as_table().unwrap().keys().filter(|k| *k != "model") {
+                let mut missing = table.clone();
+                missing.as_table_mut().unwrap().remove(key);
+                edits.push((format!("{path}.{key}"), missing));
+            }
+            for (key, edited) in edits {
+                let mut mutated = doc.clone();
+                *at(&mut mutated, &segs) = edited;
+                let file = tmp.path().join(&name);
+                std::fs::write(&file, toml::to_string(&mutated).unwrap()).unwrap();
+                let e = catch_unwind(AssertUnwindSafe(|| igimp::study::kinds::catalogue_entry(&file)))
+                    .unwrap_or_else(|_| panic!("{name}: `{key}` edited: panicked"))
+                    .expect_err(&format!("{name}: `{key}` edited: accepted"));
+                match &e {
+                    StudyError::Invalid { key: k, file, .. } => {
+                        assert_eq!(k, &key, "{name}: {e}");
+                        assert!(file.contains(':'), "{name}: no line: {e}");
+                    }
+                    other => panic!("{name}: `{key}`: {other}"),
+                }
+                probed += 1;
+            }
+        }
+    }
+    assert!(probed >= 50, "{probed} material edits probed");
+}
+
 /// Every committed study file is probed by one of the tests above.
 #[test]
 fn every_study_kind_has_a_probe() {

@@ -10,6 +10,7 @@ use igimp::basis::{
     cpdi, Basis, BasisFamily, BsplineGimpKernel, BsplineKernel, PointSupport, PointView, SplineBoundary,
     SplineDegree, TensorProduct,
 };
+use igimp::material::constitutive::Material;
 use igimp::mesh::grid::Grid;
 use igimp::mpm::particles::MaterialPoints;
 use igimp::problems::column::{solve_column, ColumnSpec};
@@ -250,7 +251,7 @@ fn every_family_converges_quadratically_on_the_column_and_the_compaction() {
         let spec = ColumnSpec {
             elements: 16,
             weight: 400_000.0,
-            poisson_ratio: 0.3,
+            material: Material::linear_elastic(1e6, 0.3),
             ..ColumnSpec::default()
         };
         let o = solve_column(&spec, method).unwrap();

@@ -5,7 +5,7 @@
 //! Run in release mode: `cargo test --release --test fem`.
 
 use igimp::fem::{LineElement, LineFem, LineFemSettings, LineLoads, LineMesh};
-use igimp::material::constitutive::LinearElastic;
+use igimp::material::constitutive::{LinearElastic, Material};
 use igimp::mesh::quadrature::GaussRule;
 use igimp::problems::column::{f_from_cauchy_stress, ColumnOutcome, ColumnSpec};
 use igimp::problems::norms::fitted_rate;
@@ -228,7 +228,7 @@ fn fem_quadratic_reproduces_linear_strain_small_strain() {
 fn fem_tangent_matches_central_differences() {
     for element in [LineElement::Linear, LineElement::Quadratic] {
         let spec = ColumnSpec {
-            poisson_ratio: 0.25,
+            material: Material::linear_elastic(1e6, 0.25),
             load_steps: 4,
             ..heavy_column(5, None)
         };

@@ -498,7 +498,7 @@ fn fem2d_newton_converges_quadratically_on_self_weight_block() {
                 .gauss
                 .state
                 .iter()
-                .filter(|s| s.material.plastic_multiplier > 0.0)
+                .filter(|s| s.material.internal.get(0) > 0.0)
                 .count();
             let corner = lu.mesh.nearest_node(V2::new(8.0, 0.0));
             println!(

@@ -5,6 +5,7 @@
 //! same inputs every time; a failure is saved to `proptest-regressions/hostile.txt` (commit it)
 //! and replayed first on the next run.
 
+use igimp::material::constitutive::Material;
 use igimp::problems::cantilever::CantileverSpec;
 use igimp::problems::column::{solve_column, ColumnSpec, Method};
 use igimp::problems::compaction::CompactionSpec;
@@ -44,6 +45,8 @@ const FIELDS: &[&str] = &[
     "report_file",
     "expected_failures",
     "column",
+    "material",
+    "model",
     "length",
     "young_modulus",
     "poisson_ratio",
@@ -84,6 +87,14 @@ const FIELDS: &[&str] = &[
     "kind",
     "slope_triangles",
 ];
+
+/// Hencky elasticity, or von Mises with a yield stress.
+fn material(young_modulus: f64, poisson_ratio: f64, yield_stress: Option<f64>) -> Material {
+    match yield_stress {
+        Some(y) => Material::von_mises(young_modulus, poisson_ratio, y),
+        None => Material::linear_elastic(young_modulus, poisson_ratio),
+    }
+}
 
 /// Parse in `catch_unwind`; a panic fails the property with the input.
 fn parse(text: &str) -> Result<Result<ColumnStudy, StudyError>, TestCaseError> {
@@ -484,8 +495,9 @@ proptest! {
         dimension in prop::sample::select(vec![1usize, 2, 3]),
     ) {
         let spec = ColumnSpec {
-            length, young_modulus, poisson_ratio, density, weight, elements, points_per_cell,
-            load_steps, newton, yield_stress, gauss_points, ghost: Default::default(), dimension,
+            length, material: material(young_modulus, poisson_ratio, yield_stress), density, weight,
+            elements, points_per_cell, load_steps, newton, gauss_points, ghost: Default::default(),
+            dimension,
         };
         let ok = no_panic("ColumnSpec::validate", || spec.validate())?.is_some();
         let small = elements * points_per_cell <= 64 && load_steps <= 3 && newton.max_iterations <= 40;
@@ -516,8 +528,8 @@ proptest! {
     ) {
         let spec = CompactionSpec {
             half_width, height, grid_extent: [gx.round(), gy.round()], element_size,
-            points_per_cell, young_modulus, poisson_ratio, weight, yield_stress, load_steps,
-            newton, weak_node_tolerance, ..CompactionSpec::default()
+            points_per_cell, material: material(young_modulus, poisson_ratio, yield_stress), weight,
+            load_steps, newton, weak_node_tolerance, ..CompactionSpec::default()
         };
         let solver = no_panic("CompactionSpec::mpm_solver", || spec.mpm_solver())?;
         if let Some(mut s) = solver {
@@ -546,7 +558,8 @@ proptest! {
         weak_node_tolerance in float_or_hostile(0.0, 0.1),
     ) {
         let spec = CantileverSpec {
-            length: length.round(), depth: depth.round(), young_modulus, poisson_ratio, load,
+            length: length.round(), depth: depth.round(),
+            material: Material::linear_elastic(young_modulus, poisson_ratio), load,
             load_steps, element_size, points_per_cell, grid_below: grid_below.round(),
             grid_margin: grid_margin.round(), newton, weak_node_tolerance,
             ..CantileverSpec::default()
@@ -675,19 +688,22 @@ fn hostile_inputs_table() {
             Some(Value::Float(f64::NEG_INFINITY)),
         ),
         ("weight 1e308", "sweeps[0].weights[0]", Some(Value::Float(1e308))),
-        ("NaN Young's modulus", "column.young_modulus", Some(nan.clone())),
+        ("NaN Young's modulus", "material.young_modulus", Some(nan.clone())),
         ("zero length", "column.length", Some(Value::Float(0.0))),
         ("negative density", "column.density", Some(Value::Float(-80.0))),
         (
             "Poisson's ratio 0.5",
-            "column.poisson_ratio",
+            "material.poisson_ratio",
             Some(Value::Float(0.5)),
         ),
         (
-            "inf yield stress",
-            "column.yield_stress",
+            "yield stress of an elastic material",
+            "material.yield_stress",
             Some(Value::Float(f64::INFINITY)),
         ),
+        ("unknown model", "material.model", Some(s("von-mieses"))),
+        ("missing material parameter", "material.poisson_ratio", None),
+        ("missing material", "material", None),
         ("zero load steps", "load_steps", Some(Value::Integer(0))),
         ("huge load steps", "load_steps", Some(Value::Integer(1 << 40))),
         ("Newton tolerance 1", "newton.tolerance", Some(Value::Float(1.0))),

@@ -9,6 +9,10 @@ mod common;
 #[path = "../../examples/custom_basis.rs"]
 mod custom_basis;
 
+/// The material extension example, checked by `examples`.
+#[path = "../../examples/hardening_von_mises.rs"]
+mod hardening_von_mises;
+
 mod basis;
 mod column;
 mod compaction;

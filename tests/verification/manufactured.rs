@@ -218,7 +218,7 @@ fn manufactured_3d_exact_solution_is_consistent() {
             ..ManufacturedSpec::default()
         };
         let exact = Exact3::of(&spec);
-        let model = LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio).unwrap();
+        let model = spec.model().unwrap();
         for _ in 0..10 {
             let x: [f64; 3] = std::array::from_fn(|_| rng.uniform(0.05, 0.95));
             let f = exact.deformation_gradient(x);

@@ -2,6 +2,7 @@
 //! adaptive load stepping, and the Newton stall diagnosis.
 
 use igimp::discretise::ghost::{GhostFaces, GhostSettings};
+use igimp::material::constitutive::Material;
 use igimp::problems::column::{solve_column, ColumnSpec, Method};
 use igimp::problems::compaction::{solve_mpm, CompactionSpec};
 use igimp::solver::error::StepFailure;
@@ -93,7 +94,7 @@ fn one_point_column_gamma_sensitivity_is_small() {
 fn cutbacks_hit_the_nominal_levels_and_are_recorded() {
     let spec = CompactionSpec {
         load_steps: 3,
-        yield_stress: Some(1.2e4),
+        material: Material::von_mises(1e5, 0.3, 1.2e4),
         ghost: GhostSettings {
             gamma: 1.0,
             faces: GhostFaces::Cut,
@@ -136,7 +137,7 @@ fn cutbacks_hit_the_nominal_levels_and_are_recorded() {
 #[test]
 fn near_incompressible_compaction_reports_the_stall() {
     let spec = CompactionSpec {
-        poisson_ratio: 0.49999999,
+        material: Material::linear_elastic(1e5, 0.49999999),
         ghost: GhostSettings {
             gamma: 1.0,
             faces: GhostFaces::Cut,

@@ -1,7 +1,21 @@
-use super::{ConstitutiveModel, MaterialError, MaterialResponse, MaterialState};
+use super::registry::{POISSON_RATIO, YOUNG_MODULUS};
+use super::{ConstitutiveModel, MaterialError, MaterialResponse, MaterialState, ModelEntry};
 use crate::material::tensor::{identity_outer, identity_sym, Tensor4};
 use crate::solver::error::InputError;
 use nalgebra::Matrix3;
+
+/// `model = "linear-elastic"`: [`LinearElastic`] with `young_modulus` and `poisson_ratio`.
+pub static ENTRY: ModelEntry = ModelEntry {
+    name: "linear-elastic",
+    summary: "Hencky elasticity: Kirchhoff stress linear in the elastic logarithmic strain, eq (14)",
+    parameters: &[YOUNG_MODULUS, POISSON_RATIO],
+    build: |m| {
+        Ok(Box::new(LinearElastic::try_new(
+            m.value("young_modulus"),
+            m.value("poisson_ratio"),
+        )?))
+    },
+};
 
 /// Isotropic linear elasticity between Kirchhoff stress and elastic log strain, eq (14):
 /// `τ = λ tr(ε) I + 2μ ε` (Hencky). Works in 3D even for 1D and plane-strain problems, so
@@ -68,7 +82,7 @@ impl ConstitutiveModel for LinearElastic {
         Ok(MaterialResponse {
             tau,
             eps_e: *eps_trial,
-            plastic_multiplier: committed.plastic_multiplier,
+            internal: committed.internal,
         })
     }
 

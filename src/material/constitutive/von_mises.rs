@@ -1,8 +1,43 @@
 use super::linear_elastic::lame;
-use super::{ConstitutiveModel, MaterialError, MaterialResponse, MaterialState};
+use super::registry::{Parameter, POISSON_RATIO, YOUNG_MODULUS};
+use super::{
+    ConstitutiveModel, InternalVariable, InternalVariables, MaterialError, MaterialResponse, MaterialState,
+    ModelEntry,
+};
 use crate::material::tensor::{identity_outer, identity_sym, outer, Tensor4};
 use crate::solver::error::InputError;
 use nalgebra::Matrix3;
+
+/// `model = "von-mises"`: [`VonMises`] with `young_modulus`, `poisson_ratio` and
+/// `yield_stress`.
+pub static ENTRY: ModelEntry = ModelEntry {
+    name: "von-mises",
+    summary: "von Mises perfect plasticity on the Kirchhoff stress, Hencky elasticity, eqs (48)-(49)",
+    parameters: &[
+        YOUNG_MODULUS,
+        POISSON_RATIO,
+        Parameter {
+            name: "yield_stress",
+            unit: "Pa",
+            meaning: "yield stress ρ_y on ρ = √(3 J2) of the Kirchhoff stress, > 0",
+        },
+    ],
+    build: |m| {
+        Ok(Box::new(VonMises::try_new(
+            m.value("young_modulus"),
+            m.value("poisson_ratio"),
+            m.value("yield_stress"),
+        )?))
+    },
+};
+
+/// Von Mises' internal variable: the accumulated plastic multiplier Σ Δγ, which with this
+/// return map's normalisation equals the equivalent plastic strain √(2/3) Σ |Δε^p|.
+pub const PLASTIC_MULTIPLIER: InternalVariable = InternalVariable {
+    name: "plastic_multiplier",
+    initial: 0.0,
+    meaning: "accumulated plastic multiplier (equivalent plastic strain), 0 where the point never yielded",
+};
 
 /// Von Mises perfect plasticity in Kirchhoff stress / logarithmic strain space, eqs (48)–(49):
 /// f = ρ − ρ_y with ρ = √(3 J2) of the Kirchhoff stress, linear elasticity (eq 14) and
@@ -76,7 +111,7 @@ impl ConstitutiveModel for VonMises {
             return Ok(MaterialResponse {
                 tau: s_trial + Matrix3::identity() * p,
                 eps_e: *eps_trial,
-                plastic_multiplier: committed.plastic_multiplier,
+                internal: InternalVariables::from_slice(&[committed.internal.get(0)]),
             });
         }
         let dgamma = (rho_trial - self.yield_stress) / (3.0 * g);
@@ -91,7 +126,7 @@ impl ConstitutiveModel for VonMises {
         Ok(MaterialResponse {
             tau: s + Matrix3::identity() * p,
             eps_e,
-            plastic_multiplier: committed.plastic_multiplier + dgamma,
+            internal: InternalVariables::from_slice(&[committed.internal.get(0) + dgamma]),
         })
     }
 
@@ -111,5 +146,9 @@ impl ConstitutiveModel for VonMises {
 
     fn young_modulus(&self) -> f64 {
         self.young_modulus
+    }
+
+    fn internal_variables(&self) -> &'static [InternalVariable] {
+        &[PLASTIC_MULTIPLIER]
     }
 }

@@ -5,7 +5,6 @@ use crate::fem::{
     ElementFamily, FemLoads, HexElement, HexMesh, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh,
     QuadElement, SolidFem,
 };
-use crate::material::constitutive::LinearElastic;
 use crate::solver::error::{InputError, SolveError};
 use crate::solver::linear::LinearSolver;
 use crate::solver::load_stepping::{LoadStepping, StepReport};
@@ -54,7 +53,7 @@ pub fn fem_q8(spec: &CantileverSpec, density: f64) -> Result<(PlaneFem, usize), 
         gravity: SVector::<f64, 2>::zeros(),
         nodal_forces: vec![(tip, SVector::<f64, 2>::new(0.0, -spec.load))],
     };
-    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    let model = spec.model()?;
     let fem = PlaneFem::try_new(mesh, density, model, fixed, loads, fem_settings(spec, Some(3)))?;
     Ok((fem, tip))
 }
@@ -112,7 +111,7 @@ pub fn solve_fem_3d(spec: &CantileverSpec, element: HexElement) -> Result<FemOut
             .map(|(&node, &f)| (node, SVector::<f64, 3>::new(0.0, -f, 0.0)))
             .collect(),
     };
-    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    let model = spec.model()?;
     let fem = SolidFem::try_new(mesh, 1.0, model, fixed, loads, fem_settings(spec, None))?;
     Ok(run_fem(spec, fem, tip))
 }

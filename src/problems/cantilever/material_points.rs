@@ -2,7 +2,6 @@
 
 use super::spec::{CantileverSpec, EndDisplacement};
 use crate::basis::Basis;
-use crate::material::constitutive::LinearElastic;
 use crate::mesh::grid::Grid;
 use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
@@ -91,7 +90,7 @@ impl CantileverSpec {
             gravity: SVector::<f64, 2>::zeros(),
             point_loads: vec![(loaded[0], force), (loaded[1], force)],
         };
-        let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
+        let model = self.model()?;
         let settings = MpmSettings {
             dynamics,
             ..self.mpm_settings(basis)
@@ -132,7 +131,7 @@ impl CantileverSpec {
             gravity: SVector::<f64, 3>::zeros(),
             point_loads: loaded.iter().map(|&p| (p, force)).collect(),
         };
-        let model = Box::new(LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?);
+        let model = self.model()?;
         Ok((
             MpmSolver::try_new(grid, points, model, fixed, loads, self.mpm_settings(basis))?,
             loaded,

@@ -63,17 +63,8 @@ pub(super) fn solve_fem_3d(
     let g = &fem.gauss;
     let records = (0..g.len())
         .map(|p| {
-            let st = &g.state[p];
-            let sigma = st.cauchy();
-            PointRecord {
-                z0: g.position0[p][2],
-                z: fem.gauss_point_position(p)[2],
-                volume0: g.volume0[p],
-                sigma_zz: sigma[(2, 2)],
-                sigma_xx: sigma[(0, 0)],
-                f_zz: st.f[(2, 2)],
-                plastic_multiplier: st.material.plastic_multiplier,
-            }
+            let at = (g.position0[p][2], fem.gauss_point_position(p)[2], g.volume0[p]);
+            PointRecord::of(fem.model(), &g.state[p], at, 2, 0)
         })
         .collect();
     let top = fem.displacement(top_node)[2];
@@ -109,16 +100,8 @@ pub fn fem_records(solver: &LineFem) -> Vec<PointRecord> {
     let g = &solver.gauss;
     (0..g.len())
         .map(|p| {
-            let sigma = g.state[p].cauchy();
-            PointRecord {
-                z0: g.position0[p],
-                z: solver.gauss_point_map(p).0,
-                volume0: g.volume0[p],
-                sigma_zz: sigma[(0, 0)],
-                sigma_xx: sigma[(1, 1)],
-                f_zz: g.state[p].f[(0, 0)],
-                plastic_multiplier: g.state[p].material.plastic_multiplier,
-            }
+            let at = (g.position0[p], solver.gauss_point_map(p).0, g.volume0[p]);
+            PointRecord::of(solver.model(), &g.state[p], at, 0, 1)
         })
         .collect()
 }

@@ -81,7 +81,7 @@ pub(super) fn solve_mpm_3d(
     observer(0, ColumnState::Mpm3(&solver));
     let (steps, failure) =
         steps_and_failure(solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Mpm3(s))));
-    Ok(mpm_outcome(spec, &solver.points, 2, 0, steps, failure))
+    Ok(mpm_outcome(spec, &solver, 2, 0, steps, failure))
 }
 
 /// Run the column with a material point method of basis `basis`.
@@ -98,7 +98,7 @@ pub(super) fn solve_mpm_observed(
     observer(0, ColumnState::Mpm(&solver));
     let (steps, failure) =
         steps_and_failure(solver.run_observed(&mut |s, r| observer(r.step, ColumnState::Mpm(s))));
-    Ok(mpm_outcome(spec, &solver.points, 0, 1, steps, failure))
+    Ok(mpm_outcome(spec, &solver, 0, 1, steps, failure))
 }
 
 /// The outcome of a material point column whose axis is `axis` (1D: 0; the 3D prism: 2):
@@ -106,25 +106,17 @@ pub(super) fn solve_mpm_observed(
 /// displacement.
 fn mpm_outcome<const D: usize>(
     spec: &ColumnSpec,
-    pts: &MaterialPoints<D>,
+    solver: &MpmSolver<D>,
     axis: usize,
     lateral: usize,
     steps: Vec<StepReport>,
     failure: Option<SolveError>,
 ) -> ColumnOutcome {
+    let pts = &solver.points;
     let records: Vec<PointRecord> = (0..pts.len())
         .map(|p| {
-            let st = &pts.state[p];
-            let sigma = st.cauchy();
-            PointRecord {
-                z0: pts.position0[p][axis],
-                z: pts.position[p][axis],
-                volume0: pts.volume0[p],
-                sigma_zz: sigma[(axis, axis)],
-                sigma_xx: sigma[(lateral, lateral)],
-                f_zz: st.f[(axis, axis)],
-                plastic_multiplier: st.material.plastic_multiplier,
-            }
+            let at = (pts.position0[p][axis], pts.position[p][axis], pts.volume0[p]);
+            PointRecord::of(solver.model(), &pts.state[p], at, axis, lateral)
         })
         .collect();
     let top = (0..pts.len())

@@ -4,7 +4,7 @@ use super::analytical::AnalyticalColumn;
 use crate::basis::method::Method;
 use crate::discretise::ghost::GhostSettings;
 use crate::fem::{LineFem, SolidFem};
-use crate::material::constitutive::{lame, ConstitutiveModel, LinearElastic};
+use crate::material::constitutive::{lame, ConstitutiveModel, InternalVariables, Material};
 use crate::mpm::MpmSolver;
 use crate::problems::norms;
 use crate::solver::error::{require_count, require_derived, require_positive, InputError, SolveError};
@@ -24,8 +24,10 @@ pub const METHODS_3D: [Method; Method::FAMILIES + 2] = Method::listed(Some(3), &
 pub struct ColumnSpec {
     /// Initial length L0.
     pub length: f64,
-    pub young_modulus: f64,
-    pub poisson_ratio: f64,
+    /// The material: the closed form ([`Self::analytical`]) is Hencky elasticity with its
+    /// `young_modulus` and `poisson_ratio`, and von Mises perfect plasticity when it has a
+    /// `yield_stress`.
+    pub material: Material,
     /// Initial density ρ0.
     pub density: f64,
     /// Total weight W = ρ0 g L0 at the end of loading; sets g.
@@ -36,9 +38,6 @@ pub struct ColumnSpec {
     pub points_per_cell: usize,
     pub load_steps: usize,
     pub newton: NewtonSettings,
-    /// Von Mises yield stress ρ_y (eq 48); absent for an elastic column.
-    #[serde(default)]
-    pub yield_stress: Option<f64>,
     /// Gauss points per element of the FEM comparators, 1..=5 (default: 2 for linear, 3 for
     /// quadratic elements, as in the paper). Not used by MPM/GIMP.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -70,15 +69,13 @@ impl Default for ColumnSpec {
     fn default() -> Self {
         Self {
             length: 50.0,
-            young_modulus: 1e6,
-            poisson_ratio: 0.0,
+            material: Material::linear_elastic(1e6, 0.0),
             density: 80.0,
             weight: 40_000.0,
             elements: 50,
             points_per_cell: 2,
             load_steps: 20,
             newton: NewtonSettings::default(),
-            yield_stress: None,
             gauss_points: None,
             ghost: GhostSettings::default(),
             dimension: 1,
@@ -93,7 +90,7 @@ impl ColumnSpec {
             return Err(InputError::new("dimension", self.dimension, "must be 1 or 3"));
         }
         require_positive("length", self.length)?;
-        LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?;
+        self.model()?;
         require_positive("density", self.density)?;
         require_positive("weight", self.weight)?;
         require_count("elements", self.elements, 1)?;
@@ -110,7 +107,6 @@ impl ColumnSpec {
         }
         crate::fem::validate_stepping(&self.newton, self.load_steps)?;
         self.newton.validate()?;
-        self.model()?;
         if let Some(n) = self.gauss_points {
             crate::mesh::quadrature::GaussRule::try_new(n)?;
         }
@@ -119,18 +115,19 @@ impl ColumnSpec {
         let with = |what: &str| format!("{what}, with W = {w:e}, ρ0 = {rho:e} and L0 = {l:e},");
         require_derived("length", l, &with("the gravity g = W/(ρ0 L0)"), self.gravity())?;
         require_derived("length", l, &with("the unit weight W/L0"), w / l)?;
-        let (lambda, mu) = lame(self.young_modulus, self.poisson_ratio);
+        let (e, nu) = self.elastic_constants()?;
+        let (lambda, mu) = lame(e, nu);
         let m = lambda + 2.0 * mu;
         require_derived("length", l, &with("the closed form's scale M L0/W"), m * l / w)?;
-        if let Some(y) = self.yield_stress {
+        if let Some(y) = self.yield_stress() {
             require_derived(
-                "yield_stress",
+                "material.yield_stress",
                 y,
                 &with("the yield height scale σy L0/W"),
                 y * l / w,
             )?;
         }
-        let s = -self.weight / self.young_modulus;
+        let s = -self.weight / e;
         if s < -1e3 {
             return Err(InputError::new(
                 "weight",
@@ -146,23 +143,35 @@ impl ColumnSpec {
     }
     /// The analytical solution of this column.
     pub fn analytical(&self) -> AnalyticalColumn {
-        let (lambda, mu) = lame(self.young_modulus, self.poisson_ratio);
+        // NaN for a material without E or ν, which validation refuses.
+        let (e, nu) = self.elastic_constants().unwrap_or((f64::NAN, f64::NAN));
+        let (lambda, mu) = lame(e, nu);
         AnalyticalColumn {
             lambda,
             mu,
             unit_weight: self.density * self.gravity(),
             length: self.length,
-            yield_stress: self.yield_stress,
+            yield_stress: self.yield_stress(),
         }
     }
 
-    /// The constitutive model: linear elastic, or von Mises when `yield_stress` is set.
+    /// The constitutive model, built from [`Self::material`].
     pub fn model(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
-        crate::material::constitutive::elastic_or_von_mises(
-            self.young_modulus,
-            self.poisson_ratio,
-            self.yield_stress,
-        )
+        self.material.build()
+    }
+
+    /// E and ν of the material, which the closed form takes.
+    pub fn elastic_constants(&self) -> Result<(f64, f64), InputError> {
+        let what = "the column's closed form (eqs 42-45)";
+        Ok((
+            self.material.require("young_modulus", what)?,
+            self.material.require("poisson_ratio", what)?,
+        ))
+    }
+
+    /// The material's yield stress ρ_y (eq 48), `None` for an elastic column.
+    pub fn yield_stress(&self) -> Option<f64> {
+        self.material.get("yield_stress")
     }
 }
 
@@ -181,18 +190,46 @@ pub struct PointRecord {
     pub sigma_xx: f64,
     /// Vertical stretch F_zz.
     pub f_zz: f64,
-    /// Accumulated plastic multiplier (0 where the point never yielded).
-    pub plastic_multiplier: f64,
+    /// The model's internal variables ([`ConstitutiveModel::internal_variables`]).
+    pub internal: InternalVariables,
+    /// Whether an internal variable has left its initial value (the point yielded, for von
+    /// Mises).
+    pub inelastic: bool,
+}
+
+impl PointRecord {
+    /// The values of one point from its committed `state` under `model`, the vertical axis
+    /// `axis` and the lateral one `lateral`.
+    pub fn of(
+        model: &dyn ConstitutiveModel,
+        state: &crate::material::kinematics::PointState,
+        (z0, z, volume0): (f64, f64, f64),
+        axis: usize,
+        lateral: usize,
+    ) -> Self {
+        let sigma = state.cauchy();
+        let internal = state.material.internal;
+        PointRecord {
+            z0,
+            z,
+            volume0,
+            sigma_zz: sigma[(axis, axis)],
+            sigma_xx: sigma[(lateral, lateral)],
+            f_zz: state.f[(axis, axis)],
+            internal,
+            inelastic: internal.has_evolved(model.internal_variables()),
+        }
+    }
 }
 
 /// Yield height seen by a discretisation: the deviatoric measure ρ = |τ_xx − τ_zz| (eq 50,
 /// τ = σ F) of the two lowest unyielded points, extrapolated linearly to ρ = ρ_y. `None` if
 /// no point yielded or fewer than two stayed elastic.
 pub fn yield_height_estimate(points: &[PointRecord], yield_stress: f64) -> Option<f64> {
-    if !points.iter().any(|p| p.plastic_multiplier > 0.0) {
+    if !points.iter().any(|p| p.inelastic) {
         return None;
     }
-    let mut elastic: Vec<&PointRecord> = points.iter().filter(|p| p.plastic_multiplier == 0.0).collect();
+    let mut elastic: Vec<&PointRecord> = points.iter().filter(|p| !p.inelastic).collect();
     elastic.sort_by(|a, b| a.z0.total_cmp(&b.z0));
     let rho = |p: &PointRecord| ((p.sigma_xx - p.sigma_zz) * p.f_zz).abs();
     // Extrapolate from the lowest elastic point and the next one with a different ρ (linear
@@ -252,7 +289,7 @@ impl ColumnOutcome {
         let sxx_h: Vec<f64> = points.iter().map(|p| p.sigma_xx).collect();
         let sigma_xx_error = norms::stress_error(&sxx_exact, &sxx_h, &v0, spec.weight, spec.length);
         let yield_height = spec
-            .yield_stress
+            .yield_stress()
             .and_then(|ry| yield_height_estimate(&points, ry));
         Self {
             points,

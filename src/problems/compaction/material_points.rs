@@ -1,6 +1,7 @@
 //! The compaction by material points: the plane-strain half block and the 3D quarter block.
 
 use super::spec::CompactionSpec;
+use crate::material::constitutive::InternalVariables;
 use crate::mesh::grid::Grid;
 use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
@@ -64,7 +65,12 @@ pub struct DomainRecord {
     pub half: [f64; 2],
     /// Cauchy stress σ_yy.
     pub sigma_yy: f64,
+    /// The model's internal variable `plastic_multiplier` (von Mises'; 0 for a model without
+    /// one), as `domains.json` stores it.
     pub plastic_multiplier: f64,
+    /// The model's internal variables, for ParaView (not stored in `domains.json`).
+    #[serde(skip)]
+    pub internal: InternalVariables,
 }
 
 /// Final state of one material point of a 3D analysis (ParaView output).
@@ -77,7 +83,15 @@ pub struct Domain3dRecord {
     pub half: [f64; 3],
     /// Cauchy stress σ_zz (vertical).
     pub sigma_zz: f64,
-    pub plastic_multiplier: f64,
+    /// The model's internal variables.
+    pub internal: InternalVariables,
+}
+
+/// Point `p`'s internal variable `plastic_multiplier`, 0 if the model has none.
+fn plastic_multiplier<const D: usize>(solver: &MpmSolver<D>, p: usize) -> f64 {
+    let declared = solver.model().internal_variables();
+    let internal = &solver.points.state[p].material.internal;
+    internal.named(declared, "plastic_multiplier").unwrap_or(0.0)
 }
 
 /// Outcome of one compaction analysis.
@@ -118,7 +132,8 @@ pub fn solve_mpm(spec: &CompactionSpec) -> Result<CompactionOutcome, InputError>
             half0: [pts.half_length0[p][0], pts.half_length0[p][1]],
             half: [pts.half_length[p][0], pts.half_length[p][1]],
             sigma_yy: pts.state[p].cauchy()[(1, 1)],
-            plastic_multiplier: pts.state[p].material.plastic_multiplier,
+            plastic_multiplier: plastic_multiplier(&solver, p),
+            internal: pts.state[p].material.internal,
         })
         .collect();
     Ok(CompactionOutcome {
@@ -204,7 +219,8 @@ pub fn solve_mpm_3d(spec: &CompactionSpec) -> Result<CompactionOutcome, InputErr
             half0: [pts.half_length0[p][0], pts.half_length0[p][2]],
             half: [pts.half_length[p][0], pts.half_length[p][2]],
             sigma_yy: pts.state[p].cauchy()[(2, 2)],
-            plastic_multiplier: pts.state[p].material.plastic_multiplier,
+            plastic_multiplier: plastic_multiplier(&solver, p),
+            internal: pts.state[p].material.internal,
         })
         .collect();
     let arr = |v: &SVector<f64, 3>| [v[0], v[1], v[2]];
@@ -215,7 +231,7 @@ pub fn solve_mpm_3d(spec: &CompactionSpec) -> Result<CompactionOutcome, InputErr
             half0: arr(&pts.half_length0[p]),
             half: arr(&pts.half_length[p]),
             sigma_zz: pts.state[p].cauchy()[(2, 2)],
-            plastic_multiplier: pts.state[p].material.plastic_multiplier,
+            internal: pts.state[p].material.internal,
         })
         .collect();
     Ok(CompactionOutcome {

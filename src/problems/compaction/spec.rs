@@ -3,7 +3,7 @@
 use crate::basis::method::Method;
 use crate::basis::Basis;
 use crate::discretise::ghost::{GhostFaces, GhostSettings};
-use crate::material::constitutive::ConstitutiveModel;
+use crate::material::constitutive::{ConstitutiveModel, Material};
 use crate::mpm::{DomainUpdate, WeakNodeTreatment};
 use crate::solver::error::{require_count, require_positive, InputError};
 use crate::solver::linear::LinearSolver;
@@ -23,13 +23,10 @@ pub struct CompactionSpec {
     pub element_size: f64,
     /// Material points per element along each axis.
     pub points_per_cell: usize,
-    pub young_modulus: f64,
-    pub poisson_ratio: f64,
+    /// The material (the paper's: Hencky elasticity, or von Mises for Figure 18 and Table 3).
+    pub material: Material,
     /// Weight of the full block, W.
     pub weight: f64,
-    /// Von Mises yield stress ρ_y; absent for the elastic case.
-    #[serde(default)]
-    pub yield_stress: Option<f64>,
     pub load_steps: usize,
     pub newton: NewtonSettings,
     /// See [`MpmSettings::weak_node_tolerance`](crate::mpm::MpmSettings::weak_node_tolerance).
@@ -67,10 +64,8 @@ impl Default for CompactionSpec {
             grid_extent: [10.0, 10.0],
             element_size: 1.0,
             points_per_cell: 2,
-            young_modulus: 1e5,
-            poisson_ratio: 0.3,
+            material: Material::linear_elastic(1e5, 0.3),
             weight: 4e5,
-            yield_stress: None,
             load_steps: 20,
             newton: NewtonSettings::default(),
             // The ghost penalty is the default treatment of nearly empty cells (measured,
@@ -136,13 +131,15 @@ impl CompactionSpec {
         Ok(())
     }
 
-    /// Linear elastic, or von Mises when `yield_stress` is set.
+    /// The constitutive model, built from [`Self::material`].
     pub fn model(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
-        crate::material::constitutive::elastic_or_von_mises(
-            self.young_modulus,
-            self.poisson_ratio,
-            self.yield_stress,
-        )
+        self.material.build()
+    }
+
+    /// The material's yield stress, `None` for an elastic block (its plastic cases take the
+    /// study's plastic ghost penalty and a `vm<yield stress>` case id).
+    pub fn yield_stress(&self) -> Option<f64> {
+        self.material.get("yield_stress")
     }
 
     /// ρ0 g of the block (density 1).

@@ -2,7 +2,6 @@
 //! automatic differentiation).
 
 use super::spec::{Field, ManufacturedSpec};
-use crate::material::constitutive::lame;
 use nalgebra::Matrix3;
 use num_dual::{Dual64, DualNum};
 use std::f64::consts::PI;
@@ -154,7 +153,7 @@ pub struct Exact {
 
 impl Exact {
     pub fn of(spec: &ManufacturedSpec) -> Self {
-        let (lambda, mu) = lame(spec.young_modulus, spec.poisson_ratio);
+        let (lambda, mu) = spec.lame();
         Exact {
             field: spec.field,
             amplitude: spec.amplitude,

@@ -34,4 +34,4 @@ pub use exact::{
 pub use measures::{errors, stress_deviations, Errors, PointValue};
 pub(crate) use solve::{fem_point_values, mpm_point_values, mpm_settings, rollers};
 pub use solve::{fem_solver, mpm_solver, solve, ManufacturedSolution};
-pub use spec::{Field, ManufacturedSpec, METHODS};
+pub use spec::{Field, ManufacturedSpec, HENCKY_ONLY, METHODS};

@@ -6,7 +6,6 @@ use super::spec::{ManufacturedSpec, METHODS};
 use crate::basis::method::Method;
 use crate::basis::Basis;
 use crate::fem::{ElementFamily, PlaneFem, PlaneFemSettings, PlaneLoads, PlaneMesh, QuadElement};
-use crate::material::constitutive::LinearElastic;
 use crate::mesh::grid::Grid;
 use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
@@ -108,7 +107,7 @@ pub fn mpm_solver(spec: &ManufacturedSpec, method: Method) -> Result<MpmSolver<2
         .collect();
     let fixed = rollers(2, |axis, value| grid.nodes_on_plane(axis, value));
     let settings = mpm_settings(spec, method);
-    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    let model = spec.model()?;
     let loads = Loads {
         gravity: SVector::zeros(),
         point_loads,
@@ -182,7 +181,7 @@ pub fn fem_solver(spec: &ManufacturedSpec, method: Method) -> Result<PlaneFem, I
         load_steps: spec.load_steps,
         linear_solver: LinearSolver::Lu,
     };
-    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    let model = spec.model()?;
     PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings)
 }
 

@@ -1,9 +1,9 @@
 //! The parameters of one manufactured-solution analysis and their checks.
 
 use crate::basis::method::Method;
-use crate::material::constitutive::LinearElastic;
+use crate::material::constitutive::{lame, ConstitutiveModel, Material, LINEAR_ELASTIC};
 use crate::mpm::DomainUpdate;
-use crate::solver::error::{require_count, require_positive, InputError};
+use crate::solver::error::{require_count, InputError};
 use crate::solver::newton::NewtonSettings;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -37,8 +37,9 @@ pub struct ManufacturedSpec {
     pub field: Field,
     /// A of the axis-aligned field or θ₀ (radians) of the vortex.
     pub amplitude: f64,
-    pub young_modulus: f64,
-    pub poisson_ratio: f64,
+    /// Hencky elasticity (`linear-elastic`): the exact solution's stresses and body force are
+    /// its.
+    pub material: Material,
     /// Cells (elements) along each side of the unit square: h = 1 / cells.
     pub cells: usize,
     /// Material points per cell along each axis (MPM, iGIMP).
@@ -67,8 +68,7 @@ impl Default for ManufacturedSpec {
         Self {
             field: Field::AxisAligned,
             amplitude: 0.1,
-            young_modulus: 1.0,
-            poisson_ratio: 0.3,
+            material: Material::linear_elastic(1.0, 0.3),
             cells: 8,
             points_per_cell: 2,
             load_steps: 10,
@@ -81,7 +81,7 @@ impl Default for ManufacturedSpec {
 
 impl ManufacturedSpec {
     pub fn validate(&self) -> Result<(), InputError> {
-        require_positive("young_modulus", self.young_modulus)?;
+        self.material.require_model(&LINEAR_ELASTIC, HENCKY_ONLY)?;
         require_count("cells", self.cells, 1)?;
         require_count("points_per_cell", self.points_per_cell, 1)?;
         if !matches!(self.dimension, 2 | 3) {
@@ -132,11 +132,26 @@ impl ManufacturedSpec {
         }
         crate::fem::validate_stepping(&self.newton, self.load_steps)?;
         self.newton.validate()?;
-        LinearElastic::try_new(self.young_modulus, self.poisson_ratio)?;
+        self.model()?;
         Ok(())
+    }
+
+    /// The constitutive model, built from [`Self::material`].
+    pub fn model(&self) -> Result<Box<dyn ConstitutiveModel>, InputError> {
+        self.material.build()
+    }
+
+    /// Lamé's (λ, μ) of the material, which the exact solution takes (NaN for a material
+    /// validation refuses).
+    pub fn lame(&self) -> (f64, f64) {
+        let get = |k| self.material.get(k).unwrap_or(f64::NAN);
+        lame(get("young_modulus"), get("poisson_ratio"))
     }
 
     pub fn element_size(&self) -> f64 {
         1.0 / self.cells as f64
     }
 }
+
+/// What the manufactured fields need of their material ([`Material::require_model`]).
+pub const HENCKY_ONLY: &str = "the manufactured solutions' stresses and body force are Hencky elasticity's";

@@ -1,7 +1,6 @@
 //! The exact motion of a dynamic manufactured analysis in time, and its body force.
 
 use super::spec::DynamicManufacturedSpec;
-use crate::material::constitutive::lame;
 use crate::problems::manufactured::{Exact, Field};
 use crate::problems::manufactured3d::Exact3;
 use crate::solver::dynamics::BodyForce;
@@ -22,7 +21,7 @@ pub struct ExactMotion {
 
 impl ExactMotion {
     pub fn of(spec: &DynamicManufacturedSpec) -> Self {
-        let (lambda, mu) = lame(spec.young_modulus, spec.poisson_ratio);
+        let (lambda, mu) = spec.static_spec().lame();
         ExactMotion {
             field: spec.field,
             amplitude: spec.amplitude,

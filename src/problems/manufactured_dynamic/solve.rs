@@ -7,7 +7,6 @@ use crate::fem::{
     ContinuumFem, ElementFamily, ElementMesh, FemLoads, HexElement, HexMesh, PlaneFemSettings, PlaneMesh,
     QuadElement,
 };
-use crate::material::constitutive::LinearElastic;
 use crate::mesh::grid::Grid;
 use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
@@ -53,7 +52,7 @@ pub fn mpm_solver<const D: usize>(
         dynamics: Some(spec.newmark()),
         ..mpm_settings(&spec.static_spec(), method)
     };
-    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    let model = spec.static_spec().model()?;
     let loads = Loads {
         gravity: SVector::zeros(),
         point_loads: vec![],
@@ -94,7 +93,7 @@ fn fem_solver_on<const D: usize, E: ElementFamily<D>>(
         load_steps: spec.time_steps(),
         linear_solver,
     };
-    let model = Box::new(LinearElastic::try_new(spec.young_modulus, spec.poisson_ratio)?);
+    let model = spec.static_spec().model()?;
     let loads = FemLoads {
         gravity: SVector::zeros(),
         nodal_forces: vec![],

@@ -18,8 +18,8 @@ use std::path::Path;
 /// d, is its EI = E d⁴/12 under a load P that is the total.
 pub(super) fn elastica_path(spec: &CantileverSpec, plane_strain: bool) -> Option<ElasticaPath> {
     let width = if spec.dimension == 3 { spec.depth } else { 1.0 };
-    let ei =
-        width * bending_stiffness(spec.young_modulus, spec.poisson_ratio, spec.depth, plane_strain).ok()?;
+    let (e, nu) = spec.elastic_constants().ok()?;
+    let ei = width * bending_stiffness(e, nu, spec.depth, plane_strain).ok()?;
     let beam = Elastica::try_new(spec.length, ei).ok()?;
     let loads = crate::problems::elastica::load_steps(spec.load, spec.load_steps);
     let tips = beam.load_path(&loads).ok()?;

@@ -17,20 +17,20 @@ pub mod kind;
 mod plan;
 pub mod records;
 
+use super::material::MaterialTable;
 use super::vocabulary::{GhostSection, NewtonSection, WeakNodeSection};
 use crate::basis::method::Method;
 use crate::mpm::{DomainUpdate, VolumeUpdate};
 use crate::problems::cantilever::CantileverSpec;
 use serde::{Deserialize, Serialize};
 
-/// The beam, material, load and discretisation (the paper's §5.3 values in the study file).
+/// The beam, load and discretisation (the paper's §5.3 values in the study file); its
+/// material is the study's `[material]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BeamSection {
     pub length: f64,
     pub depth: f64,
-    pub young_modulus: f64,
-    pub poisson_ratio: f64,
     /// End load P (N per unit width), downwards, ramped over `load_steps`.
     pub load: f64,
     pub load_steps: i64,
@@ -231,6 +231,9 @@ pub struct CantileverStudy {
     #[serde(default)]
     pub plane_stress_elastica: bool,
     pub beam: BeamSection,
+    /// The material (`[material]`; the paper's is Hencky elasticity): the elastica takes its
+    /// `young_modulus` and `poisson_ratio`.
+    pub material: MaterialTable,
     pub newton: NewtonSection,
     pub weak_nodes: WeakNodeSection,
     pub ghost: GhostSection,

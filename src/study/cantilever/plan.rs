@@ -19,6 +19,10 @@ impl CantileverStudy {
             report_file: &self.report_file,
         })?;
         let b = &self.beam;
+        let material = chk.material("material", &self.material)?;
+        let what = "the elastica (bending stiffness E d^3/12)";
+        chk.material_parameter("material", &material, "young_modulus", what)?;
+        chk.material_parameter("material", &material, "poisson_ratio", what)?;
         chk.count("beam.load_steps", b.load_steps, 1, 10_000)?;
         if !matches!(b.dimension, 2 | 3) {
             return Err(chk.err("beam.dimension", b.dimension, "must be 2 or 3"));
@@ -280,8 +284,7 @@ impl CantileverStudy {
         CantileverSpec {
             length: b.length,
             depth: b.depth,
-            young_modulus: b.young_modulus,
-            poisson_ratio: b.poisson_ratio,
+            material: self.material.material(),
             load: b.load,
             load_steps: b.load_steps.max(1) as usize,
             element_size: b.element_size,

@@ -10,6 +10,7 @@
 use super::rates::{compute_comparisons, compute_rates};
 use super::records::{AnalyticalRecord, ColumnRecord, POINTS_HEADER, POINTS_HEADER_PLASTIC, PROFILE_SAMPLES};
 use super::{ColumnCase, ColumnStudy};
+use crate::material::constitutive::InternalVariable;
 use crate::problems::column::{solve_column_observed, ColumnObserver, ColumnSpec, PointRecord};
 use crate::study::checks::{check_rate, CheckRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
@@ -40,7 +41,7 @@ pub fn run_case_observed(
     };
     // Errors are measured on converged cases only.
     let conv = out.as_ref().filter(|_| solved.status == CaseStatus::Converged);
-    let plastic = conv.filter(|_| case.spec.yield_stress.is_some());
+    let plastic = conv.filter(|_| case.spec.yield_stress().is_some());
     let yield_height = plastic.and_then(|o| o.yield_height);
     let exact_yield = case.spec.analytical().yield_height();
     let rec = ColumnRecord {
@@ -113,13 +114,16 @@ impl StudyKind for ColumnStudy {
     /// `points/<case>.csv` of every case that was solved (stale point files removed).
     fn write_side_files(&self, dir: &Path, outputs: &[Self::Output]) -> Result<(), StudyError> {
         let pdir = fresh_points_dir(dir)?;
-        let plastic = self.column.yield_stress.is_some();
+        let plastic = self.plastic();
+        // The model's internal variables are columns of their own (none for an elastic one).
+        let model = self.material.material().build();
+        let internal = model.as_ref().map_or(&[][..], |m| m.internal_variables());
         for (record, points) in outputs
             .iter()
             .filter(|o| o.0.solve.status != CaseStatus::Rejected)
         {
             let p = confined(&pdir, &format!("{}.csv", record.id))?;
-            write_file(&p, points_csv(points, plastic).as_bytes())?;
+            write_file(&p, points_csv(points, plastic, internal).as_bytes())?;
         }
         Ok(())
     }
@@ -187,15 +191,14 @@ fn analytical_records(spec: &ColumnStudy, cases: &[ColumnRecord]) -> Vec<Analyti
     loads.sort_by(f64::total_cmp);
     loads.dedup();
     let c = &spec.column;
+    let material = spec.material.material();
     loads
         .into_iter()
         .map(|load| {
             let column = ColumnSpec {
                 length: c.length,
-                young_modulus: c.young_modulus,
-                poisson_ratio: c.poisson_ratio,
+                material,
                 density: c.density,
-                yield_stress: c.yield_stress,
                 weight: load,
                 ..ColumnSpec::default()
             };
@@ -216,8 +219,8 @@ fn analytical_records(spec: &ColumnStudy, cases: &[ColumnRecord]) -> Vec<Analyti
                 top_displacement: exact.displacement(c.length),
                 base_f: exact.deformation_gradient(0.0),
                 yield_height: exact.yield_height(),
-                paper_yield_height: c
-                    .yield_stress
+                paper_yield_height: column
+                    .yield_stress()
                     .map(|ry| column.length - ry / (column.density * column.gravity())),
                 profile,
             }
@@ -230,14 +233,20 @@ pub fn points_file(case_id: &str) -> String {
     format!("points/{case_id}.csv")
 }
 
-/// One row per point, shortest round-trip formatting (so the file re-reads exactly).
-pub fn points_csv(points: &[PointRecord], plastic: bool) -> String {
+/// One row per point, shortest round-trip formatting (so the file re-reads exactly): the
+/// columns of [`POINTS_HEADER`], sigma_xx in plastic studies, then the material's internal
+/// variables `internal` by name (e.g. von Mises' `plastic_multiplier`).
+pub fn points_csv(points: &[PointRecord], plastic: bool, internal: &[InternalVariable]) -> String {
     let mut s = String::with_capacity(80 * (points.len() + 1));
     s.push_str(if plastic {
         POINTS_HEADER_PLASTIC
     } else {
         POINTS_HEADER
     });
+    for v in internal {
+        s.push(',');
+        s.push_str(v.name);
+    }
     s.push('\n');
     for p in points {
         s.push_str(&format!(
@@ -247,23 +256,25 @@ pub fn points_csv(points: &[PointRecord], plastic: bool) -> String {
         if plastic {
             s.push_str(&format!(",{}", p.sigma_xx));
         }
+        for i in 0..internal.len() {
+            s.push_str(&format!(",{}", p.internal.get(i)));
+        }
         s.push('\n');
     }
     s
 }
 
-/// Parse a points file written by [`points_csv`]: rows of (z0, z, volume0, sigma_zz, f_zz)
-/// and, in plastic studies, sigma_xx.
+/// Parse a points file written by [`points_csv`]: rows of (z0, z, volume0, sigma_zz, f_zz),
+/// in plastic studies sigma_xx, then any internal variables.
 pub fn read_points_csv(path: &Path) -> Result<Vec<Vec<f64>>, StudyError> {
     let text = std::fs::read_to_string(path).map_err(|e| StudyError::io(path, e))?;
     let mut lines = text.lines();
     let width = match lines.next() {
-        Some(POINTS_HEADER) => 5,
-        Some(POINTS_HEADER_PLASTIC) => 6,
+        Some(h) if h == POINTS_HEADER || h.starts_with(&format!("{POINTS_HEADER},")) => h.split(',').count(),
         _ => {
             return Err(StudyError::io(
                 path,
-                format!("header must be `{POINTS_HEADER}` or `{POINTS_HEADER_PLASTIC}`"),
+                format!("header must start with `{POINTS_HEADER}`"),
             ))
         }
     };

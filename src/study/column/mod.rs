@@ -7,6 +7,7 @@ pub mod rates;
 pub mod records;
 mod validate;
 
+use super::material::MaterialTable;
 use super::results::SweepIndex;
 use super::vocabulary::{weight_label, NewtonSection};
 use super::Tier;
@@ -72,21 +73,14 @@ impl Measure {
     }
 }
 
-/// Material and geometry of the column (§5.1).
+/// Geometry and density of the column (§5.1); its material is the study's `[material]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ColumnSection {
     /// Initial length L0 (m).
     pub length: f64,
-    /// Young's modulus E (Pa).
-    pub young_modulus: f64,
-    /// Poisson's ratio ν, in [0, 0.5).
-    pub poisson_ratio: f64,
     /// Initial density ρ0 (kg/m³).
     pub density: f64,
-    /// Von Mises yield stress ρ_y (Pa), eq (48); absent for the elastic column.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub yield_stress: Option<f64>,
 }
 
 /// Overrides applied to a sweep in the quick tier (each key optional).
@@ -237,6 +231,10 @@ pub struct ColumnStudy {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub expected_failures: Vec<crate::study::vocabulary::ExpectedFailure>,
     pub column: ColumnSection,
+    /// The material (`[material]`): Hencky elasticity (`linear-elastic`) or, for the plastic
+    /// column, von Mises (`von-mises`, whose `yield_stress` adds the plastic measures); its
+    /// Poisson's ratio in [0, 0.5).
+    pub material: MaterialTable,
     /// Load steps (gravity ramped linearly); 1..=10000.
     pub load_steps: i64,
     pub newton: NewtonSection,
@@ -300,6 +298,12 @@ pub struct SweepPlan {
 }
 
 impl ColumnStudy {
+    /// Whether the material has a yield stress: the plastic column, with its measures
+    /// σ_xx error and yield height.
+    pub fn plastic(&self) -> bool {
+        self.material.get("yield_stress").is_some()
+    }
+
     pub fn sweep(&self, id: &str) -> Option<&Sweep> {
         self.sweeps.iter().find(|s| s.id == id)
     }
@@ -336,10 +340,8 @@ impl ColumnStudy {
     pub fn column_spec(&self, weight: f64, elements: usize, ppc: usize, plan: &SweepPlan) -> ColumnSpec {
         ColumnSpec {
             length: self.column.length,
-            young_modulus: self.column.young_modulus,
-            poisson_ratio: self.column.poisson_ratio,
+            material: self.material.material(),
             density: self.column.density,
-            yield_stress: self.column.yield_stress,
             weight,
             elements,
             points_per_cell: ppc,

@@ -84,7 +84,7 @@ pub fn compute_rates(
             for &load in &plan.weights {
                 for &ppc in &ppcs {
                     let s = series(cases, ids, method, load, ppc);
-                    for &measure in Measure::all(spec.column.yield_stress.is_some()) {
+                    for &measure in Measure::all(spec.plastic()) {
                         let pts: Vec<(usize, f64)> = s
                             .iter()
                             .filter_map(|c| case_error(c, measure).map(|e| (c.elements, e)))

@@ -8,9 +8,10 @@ use crate::solver::newton::NewtonSettings;
 use crate::study::results::{case_record, Envelope, SolveRecord};
 use serde::{Deserialize, Serialize};
 
-/// Header of the per-case point files.
+/// Header of the per-case point files; the material's internal variables follow by name.
 pub const POINTS_HEADER: &str = "z0,z,volume0,sigma_zz,f_zz";
-/// Header of the per-case point files of plastic studies (adds the lateral stress).
+/// Header of the per-case point files of plastic studies (adds the lateral stress), before
+/// the internal variables.
 pub const POINTS_HEADER_PLASTIC: &str = "z0,z,volume0,sigma_zz,f_zz,sigma_xx";
 
 /// Result of one case.

@@ -36,14 +36,14 @@ impl ColumnStudy {
         }
         let col = &self.column;
         c.positive("column.length", col.length)?;
-        c.positive("column.young_modulus", col.young_modulus)?;
-        if !(col.poisson_ratio.is_finite() && (0.0..0.5).contains(&col.poisson_ratio)) {
-            return Err(c.err("column.poisson_ratio", col.poisson_ratio, "must lie in [0, 0.5)"));
+        let material = c.material("material", &self.material)?;
+        let what = "the column's closed form (eqs 42-45)";
+        c.material_parameter("material", &material, "young_modulus", what)?;
+        let nu = c.material_parameter("material", &material, "poisson_ratio", what)?;
+        if !(0.0..0.5).contains(&nu) {
+            return Err(c.err("material.poisson_ratio", nu, "must lie in [0, 0.5)"));
         }
         c.positive("column.density", col.density)?;
-        if let Some(ry) = col.yield_stress {
-            c.positive("column.yield_stress", ry)?;
-        }
         c.count("load_steps", self.load_steps, 1, 10_000)?;
         c.newton("newton", &self.newton)?;
         c.non_empty("sweeps", &self.sweeps)?;
@@ -247,7 +247,7 @@ impl ColumnStudy {
             }
         }
         c.non_empty(&k("weights"), weights)?;
-        let limit = 1e3 * self.column.young_modulus;
+        let limit = 1e3 * self.material.get("young_modulus").unwrap_or(f64::NAN);
         for (j, &w) in weights.iter().enumerate() {
             let key = format!("{}[{j}]", k("weights"));
             c.positive(&key, w)?;
@@ -255,7 +255,7 @@ impl ColumnStudy {
                 return Err(c.err(
                     key,
                     short(w),
-                    format!("must be <= 1000 × column.young_modulus = {limit}"),
+                    format!("must be <= 1000 × material.young_modulus = {limit}"),
                 ));
             }
         }

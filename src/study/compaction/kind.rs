@@ -5,6 +5,7 @@
 use super::records::{CompactionMeasures, CompactionRecord};
 use super::{CompactionCase, CompactionFigureKind, CompactionStudy};
 use crate::basis::method::Method;
+use crate::material::constitutive::InternalVariables;
 use crate::problems::compaction::{solve, Domain3dRecord, DomainRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{write_case_data, CaseStatus, SolveRecord, SweepIndex};
@@ -33,7 +34,7 @@ fn solve_case(case: &CompactionCase) -> (CompactionRecord, Vec<DomainRecord>, Ve
         method: case.method,
         h: s.element_size,
         points_per_cell: (!case.method.is_fem()).then_some(s.points_per_cell),
-        yield_stress: s.yield_stress,
+        yield_stress: s.yield_stress(),
         weak_node_tolerance: s.weak_node_tolerance,
         ghost_gamma: if case.method.is_fem() { 0.0 } else { s.ghost.gamma },
         ghost_faces: s.ghost.faces,
@@ -112,7 +113,8 @@ impl CompactionStudy {
 }
 
 /// ParaView files of an iGIMP or MPM case: the initial domains and those of the last
-/// converged step (the vertical stress and the plastic multiplier as cell data):
+/// converged step (the vertical stress and the material's internal variables, by name, as
+/// cell data):
 /// quadrilaterals in 2D, every point's hexahedron in 3D (`domains_3d`), with the background
 /// grid.
 fn write_case_vtk(
@@ -130,35 +132,33 @@ fn write_case_vtk(
         domains,
         scalars,
     };
-    let (initial, last, stress, plastic): (Vec<DomainBox>, Vec<DomainBox>, Vec<f64>, Vec<f64>) =
-        if case.spec.dimension == 3 {
-            (
-                doms_3d.iter().map(|d| DomainBox::new(d.x0, d.half0)).collect(),
-                doms_3d.iter().map(|d| DomainBox::new(d.x, d.half)).collect(),
-                doms_3d.iter().map(|d| d.sigma_zz).collect(),
-                doms_3d.iter().map(|d| d.plastic_multiplier).collect(),
-            )
-        } else {
-            (
-                doms.iter().map(|d| DomainBox::new(d.x0, d.half0)).collect(),
-                doms.iter().map(|d| DomainBox::new(d.x, d.half)).collect(),
-                doms.iter().map(|d| d.sigma_yy).collect(),
-                doms.iter().map(|d| d.plastic_multiplier).collect(),
-            )
-        };
+    type Columns = (Vec<DomainBox>, Vec<DomainBox>, Vec<f64>, Vec<InternalVariables>);
+    let (initial, last, stress, internal): Columns = if case.spec.dimension == 3 {
+        (
+            doms_3d.iter().map(|d| DomainBox::new(d.x0, d.half0)).collect(),
+            doms_3d.iter().map(|d| DomainBox::new(d.x, d.half)).collect(),
+            doms_3d.iter().map(|d| d.sigma_zz).collect(),
+            doms_3d.iter().map(|d| d.internal).collect(),
+        )
+    } else {
+        (
+            doms.iter().map(|d| DomainBox::new(d.x0, d.half0)).collect(),
+            doms.iter().map(|d| DomainBox::new(d.x, d.half)).collect(),
+            doms.iter().map(|d| d.sigma_yy).collect(),
+            doms.iter().map(|d| d.internal).collect(),
+        )
+    };
     let vertical = if case.spec.dimension == 3 {
         "sigma_zz"
     } else {
         "sigma_yy"
     };
-    let frames = [
-        frame(0, initial, vec![]),
-        frame(
-            steps,
-            last,
-            vec![(vertical.into(), stress), ("plastic_multiplier".into(), plastic)],
-        ),
-    ];
+    let model = case.spec.model().map_err(|e| StudyError::io(dir, e))?;
+    let mut scalars = vec![(vertical.to_string(), stress)];
+    for (i, v) in model.internal_variables().iter().enumerate() {
+        scalars.push((v.name.to_string(), internal.iter().map(|x| x.get(i)).collect()));
+    }
+    let frames = [frame(0, initial, vec![]), frame(steps, last, scalars)];
     let s = &case.spec;
     let grid = grid_part(s.dimension, || s.grid_2d(), || s.grid_3d());
     write_domain_frames(dir, &case.id, &frames, grid.as_ref()).map(|_| ())

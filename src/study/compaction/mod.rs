@@ -2,7 +2,8 @@
 //! `table2.md`, `table3.md` and Figures 15–18.
 //!
 //! A sweep is methods × element sizes × points per cell × weak-node tolerances for one
-//! material (elastic, or von Mises when `yield_stress` is set). Figure 17 normalises the
+//! material: the study's `[material]`, or the `[materials.<name>]` it names (`material =
+//! "<name>"`; the plastic sweeps' von Mises). Figure 17 normalises the
 //! maximum horizontal displacement by a reference: the converged Q4 FEM value of the
 //! `reference.fem_sweep` (Richardson-extrapolated over its finest three meshes when they allow
 //! it, else its finest mesh), or, when no FEM case converged, the finest iGIMP case of the
@@ -14,12 +15,14 @@ pub mod kind;
 mod plan;
 pub mod records;
 
+use super::material::MaterialTable;
 use super::vocabulary::{GhostSection, NewtonSection, WeakNodeSection};
 use crate::basis::method::Method;
 use crate::problems::compaction::CompactionSpec;
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
-/// Geometry, material and loading of the block (the paper's §5.2 values in the study file).
+/// Geometry and loading of the block (the paper's §5.2 values in the study file).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BlockSection {
@@ -30,8 +33,6 @@ pub struct BlockSection {
     /// horizontal extent of both horizontal axes, and the height).
     #[serde(deserialize_with = "crate::study::vocabulary::exactly_two")]
     pub grid_extent: [f64; 2],
-    pub young_modulus: f64,
-    pub poisson_ratio: f64,
     /// Weight w of the full block at the end of loading.
     pub weight: f64,
     /// Gravity is ramped linearly over this many load steps.
@@ -77,9 +78,9 @@ pub struct CompactionSweep {
     pub id: String,
     pub title: String,
     pub methods: Vec<Method>,
-    /// Von Mises yield stress ρ_y; absent: linear elastic.
+    /// The name of the `[materials.<name>]` table the sweep solves; absent: `[material]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub yield_stress: Option<f64>,
+    pub material: Option<String>,
     pub element_sizes: Vec<f64>,
     /// Material points per element along each axis (iGIMP only).
     pub points_per_cell: Vec<i64>,
@@ -263,6 +264,13 @@ pub struct CompactionStudy {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub expected_failures: Vec<crate::study::vocabulary::ExpectedFailure>,
     pub block: BlockSection,
+    /// The material of every sweep that names no other (`[material]`; the paper's Hencky
+    /// elasticity).
+    pub material: MaterialTable,
+    /// Further materials by name (`[materials.<name>]`; the paper's von Mises), for the sweeps
+    /// that name them.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub materials: BTreeMap<String, MaterialTable>,
     pub newton: NewtonSection,
     pub weak_nodes: WeakNodeSection,
     pub ghost: GhostSection,

@@ -4,6 +4,7 @@
 
 use super::{CompactionCase, CompactionFigureKind, CompactionStudy, CompactionSweep};
 use crate::basis::method::Method;
+use crate::material::constitutive::Material;
 use crate::problems::compaction::{methods, CompactionSpec};
 use crate::study::engine::distinct_cases;
 use crate::study::results::SweepIndex;
@@ -11,7 +12,69 @@ use crate::study::vocabulary::{max_points_per_axis, number, Checker, Header, MAX
 use crate::study::{StudyError, Tier};
 use std::collections::BTreeSet;
 
+/// A material's part of a case id: `elastic` (Hencky), `vm<yield stress>` (von Mises), else
+/// the model's name.
+fn material_tag(material: &Material) -> String {
+    match (material.model(), material.get("yield_stress")) {
+        ("linear-elastic", _) => "elastic".to_string(),
+        ("von-mises", Some(y)) => format!("vm{}", number(y)),
+        (model, _) => model.to_string(),
+    }
+}
+
 impl CompactionStudy {
+    /// The material sweep `s` solves: the `[materials.<name>]` it names, else `[material]`
+    /// (checked when the study was read: [`Self::check_materials`]).
+    pub(super) fn sweep_material(&self, s: &CompactionSweep) -> Material {
+        match s.material.as_ref().and_then(|name| self.materials.get(name)) {
+            Some(table) => table.material(),
+            None => self.material.material(),
+        }
+    }
+
+    /// `[material]` and every `[materials.<name>]` resolve, each sweep's `material` names one,
+    /// and two different materials do not share a case-id tag ([`material_tag`]).
+    fn check_materials(&self, chk: &Checker<'_>) -> Result<(), StudyError> {
+        let mut tags = vec![(
+            material_tag(&chk.material("material", &self.material)?),
+            "material".to_string(),
+        )];
+        for (name, table) in &self.materials {
+            let path = format!("materials.{name}");
+            chk.ident(&path, name)?;
+            let m = chk.material(&path, table)?;
+            let tag = material_tag(&m);
+            if let Some((_, other)) = tags.iter().find(|(t, _)| *t == tag) {
+                return Err(chk.err(
+                    path,
+                    format!("{tag:?}"),
+                    format!("must differ from `{other}`: both name their cases {tag:?}"),
+                ));
+            }
+            tags.push((tag, format!("materials.{name}")));
+        }
+        for (i, s) in self.sweeps.iter().enumerate() {
+            if let Some(name) = &s.material {
+                if !self.materials.contains_key(name) {
+                    let known: Vec<&str> = self.materials.keys().map(String::as_str).collect();
+                    return Err(chk.err(
+                        format!("sweeps[{i}].material"),
+                        format!("{name:?}"),
+                        format!(
+                            "must name a [materials.<name>] table of the study (it has: {})",
+                            if known.is_empty() {
+                                "none".to_string()
+                            } else {
+                                known.join(", ")
+                            }
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Checks the header, that every sweep's cases are valid problem inputs (the solver's own
     /// validation names the field), and that references name existing sweeps and cases.
     pub(super) fn check(&self, file: &str) -> Result<(), StudyError> {
@@ -25,6 +88,7 @@ impl CompactionStudy {
             report_file: &self.report_file,
         })?;
         chk.count("block.load_steps", self.block.load_steps, 1, 10_000)?;
+        self.check_materials(&chk)?;
         if !matches!(self.block.dimension, 2 | 3) {
             return Err(chk.err("block.dimension", self.block.dimension, "must be 2 or 3"));
         }
@@ -220,15 +284,15 @@ impl CompactionStudy {
             grid_extent: b.grid_extent,
             element_size: h,
             points_per_cell: ppc,
-            young_modulus: b.young_modulus,
-            poisson_ratio: b.poisson_ratio,
+            material: self.sweep_material(s),
             weight: b.weight,
-            yield_stress: s.yield_stress,
             load_steps: b.load_steps.max(1) as usize,
             newton: self.newton.settings(),
             weak_node_tolerance: tolerance,
             weak_node_treatment: self.weak_nodes.treatment,
-            ghost: self.ghost.settings(ppc, s.yield_stress.is_some(), gamma),
+            ghost: self
+                .ghost
+                .settings(ppc, self.sweep_material(s).get("yield_stress").is_some(), gamma),
             dimension: self.block.dimension as usize,
             linear_solver: s.linear_solver.unwrap_or_default(),
             ..CompactionSpec::default()
@@ -236,10 +300,7 @@ impl CompactionStudy {
     }
 
     pub(super) fn case_id(&self, method: Method, spec: &CompactionSpec) -> String {
-        let material = match spec.yield_stress {
-            None => "elastic".to_string(),
-            Some(y) => format!("vm{}", number(y)),
-        };
+        let material = material_tag(&spec.material);
         let mut id = format!("{}-{material}-h{}", method.name(), number(spec.element_size));
         if spec.linear_solver == crate::solver::linear::LinearSolver::Iterative {
             id.push_str("-cg");
@@ -252,7 +313,7 @@ impl CompactionStudy {
             if spec.ghost
                 != self
                     .ghost
-                    .settings(spec.points_per_cell, spec.yield_stress.is_some(), None)
+                    .settings(spec.points_per_cell, spec.yield_stress().is_some(), None)
             {
                 id.push_str(&format!("-g{}", number(spec.ghost.gamma)));
             }

@@ -197,6 +197,7 @@ impl DynamicStudy {
     /// The bar's spec of one case.
     pub fn bar_spec(
         b: &BarSection,
+        material: Material,
         newton: &NewtonSection,
         mass: MassMatrix,
         elements: i64,
@@ -205,7 +206,7 @@ impl DynamicStudy {
     ) -> BarSpec {
         BarSpec {
             length: b.length,
-            young_modulus: b.young_modulus,
+            material,
             density: b.density,
             velocity: b.velocity,
             elements: elements as usize,
@@ -224,6 +225,7 @@ impl DynamicStudy {
     /// cell along each axis, `steps` per T₁.
     pub fn cantilever_spec(
         c: &CantileverSection,
+        material: Material,
         newton: &NewtonSection,
         mass: MassMatrix,
         elements: i64,
@@ -233,8 +235,7 @@ impl DynamicStudy {
         let beam = CantileverSpec {
             length: c.length,
             depth: c.depth,
-            young_modulus: c.young_modulus,
-            poisson_ratio: c.poisson_ratio,
+            material,
             load: c.load,
             element_size: c.depth / elements as f64,
             points_per_cell: ppc as usize,
@@ -269,14 +270,23 @@ impl DynamicStudy {
         ppc: i64,
         steps: i64,
     ) -> Option<CaseSpec> {
+        let m = self.material.material();
         if let Some(c) = &self.cantilever {
             let r = reference?;
-            let spec = Self::cantilever_spec(c, &self.newton, mass, elements, ppc, steps);
+            let spec = Self::cantilever_spec(c, m, &self.newton, mass, elements, ppc, steps);
             return Some(CaseSpec::Cantilever(CantileverCase {
                 spec,
                 reference: ReferenceRun {
                     method: r.method.unwrap_or(method),
-                    spec: Self::cantilever_spec(c, &self.newton, mass, r.elements, ppc, r.steps_per_period),
+                    spec: Self::cantilever_spec(
+                        c,
+                        m,
+                        &self.newton,
+                        mass,
+                        r.elements,
+                        ppc,
+                        r.steps_per_period,
+                    ),
                 },
             }));
         }
@@ -286,7 +296,7 @@ impl DynamicStudy {
                 spec,
                 reference: BarReferenceRun {
                     method: r.method.unwrap_or(method),
-                    spec: Self::bar_spec(b, &self.newton, mass, r.elements, ppc, r.steps_per_period),
+                    spec: Self::bar_spec(b, m, &self.newton, mass, r.elements, ppc, r.steps_per_period),
                 },
             }),
             (spec, _, _) => spec,
@@ -307,6 +317,7 @@ impl DynamicStudy {
         if let Some(b) = &self.bar {
             return Some(CaseSpec::Bar(Self::bar_spec(
                 b,
+                self.material.material(),
                 &self.newton,
                 mass,
                 elements,
@@ -322,8 +333,7 @@ impl DynamicStudy {
                 Field::AxisAligned => m.amplitude.axis_aligned,
                 Field::Vortex => m.amplitude.vortex,
             },
-            young_modulus: m.young_modulus,
-            poisson_ratio: m.poisson_ratio,
+            material: self.material.material(),
             density: m.density,
             cells: elements as usize,
             points_per_cell: ppc as usize,

@@ -277,7 +277,16 @@ impl StudyKind for DynamicStudy {
     fn measure(results: &mut Results<Self>) {
         let study = &results.study;
         results.measures.exact_period = match &study.cantilever {
-            Some(c) => DynamicStudy::cantilever_spec(c, &study.newton, Default::default(), 2, 1, 1).period(),
+            Some(c) => DynamicStudy::cantilever_spec(
+                c,
+                study.material.material(),
+                &study.newton,
+                Default::default(),
+                2,
+                1,
+                1,
+            )
+            .period(),
             None => study
                 .sweeps
                 .iter()

@@ -17,6 +17,7 @@ pub use cases::*;
 use super::vocabulary::{Checker, Header, NewtonSection};
 use super::{StudyError, Tier};
 use crate::basis::method::Method;
+use crate::material::constitutive::Material;
 use crate::problems::bar::BarSpec;
 use crate::problems::cantilever::CantileverSpec;
 use crate::problems::cantilever_dynamic::DynamicCantileverSpec;
@@ -33,7 +34,6 @@ use std::collections::BTreeSet;
 #[serde(deny_unknown_fields)]
 pub struct BarSection {
     pub length: f64,
-    pub young_modulus: f64,
     pub density: f64,
     /// Peak initial velocity v₀ of the first mode.
     pub velocity: f64,
@@ -54,8 +54,6 @@ pub struct BarSection {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ManufacturedSection {
-    pub young_modulus: f64,
-    pub poisson_ratio: f64,
     /// ρ₀.
     pub density: f64,
     /// Peak amplitude of each field (A of the axis-aligned field, θ₀ of the vortex).
@@ -81,8 +79,6 @@ pub struct ManufacturedSection {
 pub struct CantileverSection {
     pub length: f64,
     pub depth: f64,
-    pub young_modulus: f64,
-    pub poisson_ratio: f64,
     /// P (N), downwards.
     pub load: f64,
     pub density: f64,
@@ -315,6 +311,9 @@ pub struct DynamicStudy {
     pub manufactured: Option<ManufacturedSection>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cantilever: Option<CantileverSection>,
+    /// The material of every case (`[material]`): Hencky elasticity (`linear-elastic`), whose
+    /// closed forms and strain energy the measures take.
+    pub material: crate::study::material::MaterialTable,
     pub newton: NewtonSection,
     pub sweeps: Vec<DynamicSweep>,
     #[serde(default)]

@@ -34,6 +34,11 @@ impl DynamicStudy {
                 "exactly one of [bar], [manufactured] and [cantilever] must define the problem",
             ));
         }
+        let material = chk.material("material", &self.material)?;
+        let hencky = "the dynamic problems' closed forms and strain energy are Hencky elasticity's";
+        material
+            .require_model(&crate::material::constitutive::LINEAR_ELASTIC, hencky)
+            .map_err(|e| chk.err(e.field, e.value, e.allowed))?;
         // A section's positive fields, and its duration: the period is measured between two
         // downward crossings (`of`), which 1.5 periods contain.
         let timed_section = |fields: &[(&str, f64)], periods: (&str, f64), of: &str| {
@@ -54,7 +59,6 @@ impl DynamicStudy {
                 &[
                     ("cantilever.length", c.length),
                     ("cantilever.depth", c.depth),
-                    ("cantilever.young_modulus", c.young_modulus),
                     ("cantilever.load", c.load),
                     ("cantilever.density", c.density),
                     ("cantilever.grid_below", c.grid_below),
@@ -69,7 +73,6 @@ impl DynamicStudy {
             (Some(b), None) => timed_section(
                 &[
                     ("bar.length", b.length),
-                    ("bar.young_modulus", b.young_modulus),
                     ("bar.density", b.density),
                     ("bar.velocity", b.velocity),
                 ],
@@ -81,7 +84,6 @@ impl DynamicStudy {
                     return Err(chk.err("manufactured.dimension", m.dimension, "must be 2 or 3"));
                 }
                 for (k, v) in [
-                    ("manufactured.young_modulus", m.young_modulus),
                     ("manufactured.density", m.density),
                     ("manufactured.periods", m.periods),
                 ] {

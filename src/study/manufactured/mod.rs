@@ -9,6 +9,7 @@ pub mod kind;
 mod plan;
 pub mod records;
 
+use super::material::MaterialTable;
 use super::vocabulary::NewtonSection;
 use crate::basis::method::Method;
 use crate::mpm::DomainUpdate;
@@ -36,14 +37,6 @@ pub use crate::problems::manufactured::PointValue;
 use serde::{Deserialize, Serialize};
 
 pub use records::{ManufacturedMeasures, ManufacturedRecord, ManufacturedResults, RateRecord};
-
-/// Hencky elasticity of every case.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MaterialSection {
-    pub young_modulus: f64,
-    pub poisson_ratio: f64,
-}
 
 /// The amplitude of each field: A of the axis-aligned field, θ₀ (radians) of the vortex.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -209,7 +202,9 @@ pub struct ManufacturedStudy {
     /// igimp, fem-hex8, fem-hex20; points_per_cell³ points per cell; no domain figures).
     #[serde(default = "plane", skip_serializing_if = "is_plane")]
     pub dimension: i64,
-    pub material: MaterialSection,
+    /// The material of every case (`[material]`): Hencky elasticity (`linear-elastic`), whose
+    /// stresses and body force the exact solutions are.
+    pub material: MaterialTable,
     pub amplitude: AmplitudeSection,
     pub load_steps: i64,
     pub newton: NewtonSection,

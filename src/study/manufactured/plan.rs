@@ -3,6 +3,7 @@
 
 use super::{FigureKind, ManufacturedCase, ManufacturedStudy, ManufacturedSweep};
 use crate::basis::method::Method;
+use crate::material::constitutive::LINEAR_ELASTIC;
 use crate::mpm::DomainUpdate;
 use crate::problems::manufactured::{Field, ManufacturedSpec, METHODS};
 use crate::problems::manufactured3d::METHODS_3D;
@@ -53,6 +54,10 @@ impl ManufacturedStudy {
             return Err(chk.err("dimension", self.dimension, "must be 2 or 3"));
         }
         let (dimension, methods) = (self.dimension, self.methods());
+        let material = chk.material("material", &self.material)?;
+        material
+            .require_model(&LINEAR_ELASTIC, crate::problems::manufactured::HENCKY_ONLY)
+            .map_err(|e| chk.err(e.field, e.value, e.allowed))?;
         chk.count("load_steps", self.load_steps, 1, 10_000)?;
         chk.newton("newton", &self.newton)?;
         chk.non_empty("sweeps", &self.sweeps)?;
@@ -240,8 +245,7 @@ impl ManufacturedStudy {
                 Field::AxisAligned => self.amplitude.axis_aligned,
                 Field::Vortex => self.amplitude.vortex,
             },
-            young_modulus: self.material.young_modulus,
-            poisson_ratio: self.material.poisson_ratio,
+            material: self.material.material(),
             cells: cells.max(1) as usize,
             points_per_cell: ppc.max(1) as usize,
             load_steps: self.load_steps.max(1) as usize,

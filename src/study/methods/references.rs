@@ -42,7 +42,7 @@ pub(super) fn compaction(name: &str, r: &Value, out: &mut MethodsResults) {
             .filter_map(method_of)
             .filter(|m| !m.is_fem())
             .collect();
-        if methods.len() < 2 || !sw["ghost_gammas"].is_null() || !sw["yield_stress"].is_null() {
+        if methods.len() < 2 || !sw["ghost_gammas"].is_null() || !sw["material"].is_null() {
             continue;
         }
         let ids: Vec<&str> = r["sweep_cases"][id]

@@ -53,7 +53,9 @@ pub fn report_markdown(results: &Results, not_drawn: &[super::NotDrawn]) -> Stri
     let _ = writeln!(
         s,
         "Hencky elasticity E = {}, ν = {}; the unit {body} filled by material and grid; rollers on every {boundary}; the manufactured body force ramped over {} load steps. Errors at the material (Gauss) points: displacement ‖x_p − x(X_p)‖ / ‖u(X_p)‖, stress Σ‖σ_p − σ(X_p)‖ v_p0 / (σ_max |Ω₀|). Rates are slopes of log(error) against log(h); pairwise rates in brackets.\n",
-        study.material.young_modulus, study.material.poisson_ratio, study.load_steps
+        study.material.parameter("young_modulus"),
+        study.material.parameter("poisson_ratio"),
+        study.load_steps
     );
     for sw in &study.sweeps {
         let Some(ids) = results.sweep_cases.get(&sw.id) else {

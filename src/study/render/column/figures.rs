@@ -35,7 +35,7 @@ pub fn render_figure(
                 label: "analytical σzz, eqs (42)-(45)".into(),
                 points: exact.profile.iter().map(|r| (r[2], r[1])).collect(),
             }];
-            let plastic = results.study.column.yield_stress.is_some();
+            let plastic = results.study.plastic();
             if plastic {
                 // The lateral stress is recorded in the sixth column of plastic point files.
                 for (m, ppc) in sweep_series(results, &fig.sweep, fig.weight) {

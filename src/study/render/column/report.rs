@@ -115,7 +115,7 @@ pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::study::rende
         s.push('\n');
     }
 
-    if spec.column.yield_stress.is_some() {
+    if spec.plastic() {
         let _ = writeln!(s, "## Yield height\n");
         let _ = writeln!(
             s,
@@ -177,7 +177,7 @@ pub fn report_markdown(results: &ColumnResults, not_drawn: &[crate::study::rende
         for &load in &plan.weights {
             for (m, ppc) in sweep_series(results, &sweep.id, load) {
                 let cs = series(&results.cases, ids, m, load, ppc);
-                let plastic = spec.column.yield_stress.is_some();
+                let plastic = spec.plastic();
                 let slopes: Vec<String> = Measure::all(plastic)
                     .iter()
                     .map(|&m_| {
