@@ -45,7 +45,7 @@ impl Default for PlaneFemSettings {
             gauss_points: None,
             newton: NewtonSettings::default(),
             load_steps: 1,
-            linear_solver: LinearSolver::Lu,
+            linear_solver: LinearSolver::Auto,
         }
     }
 }

@@ -8,7 +8,7 @@
 
 use crate::solver::error::SolverError;
 use crate::solver::sparse::CscRef;
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::MemStack;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, LdltRef, LltRef, SymbolicCholesky, SymmetricOrdering,
@@ -43,6 +43,43 @@ pub struct DirectSolver {
     /// The pattern's row indices widened to faer's index type (the matrix keeps them in 4
     /// bytes, faer takes one type for pointers and indices), kept with the symbolic analyses.
     rows: Vec<usize>,
+    /// Where each entry's mirror `(j, i)` sits in the values, once asked
+    /// ([`Self::is_symmetric`]); the inner `None` if the pattern is not structurally symmetric.
+    mirror: Option<Option<Vec<usize>>>,
+    /// Work space of the symmetric factorisations and solves, kept so that a Newton
+    /// iteration allocates none.
+    scratch: Vec<std::mem::MaybeUninit<u8>>,
+    /// √|a_ii| of the last [`Self::is_symmetric`].
+    scale: Vec<f64>,
+}
+
+/// A work space of at least `req` bytes in `scratch`, grown (never shrunk) as needed.
+fn stack_of(scratch: &mut Vec<std::mem::MaybeUninit<u8>>, req: faer::dyn_stack::StackReq) -> &mut MemStack {
+    let bytes = req.unaligned_bytes_required();
+    if scratch.len() < bytes {
+        scratch.resize(bytes, std::mem::MaybeUninit::uninit());
+    }
+    MemStack::new(scratch)
+}
+
+/// The position of each entry's mirror in a column-compressed pattern whose rows ascend in
+/// each column, or `None` if some `(i, j)` has no `(j, i)`. One pass: the columns are read
+/// in order, so each column's mirrors are met in its own row order (a cursor per column).
+fn mirror_positions(a: &CscRef<'_>) -> Option<Vec<usize>> {
+    let mut cursor: Vec<usize> = a.col_ptr[..a.n].to_vec();
+    let mut mirror = vec![0usize; a.row_idx.len()];
+    for j in 0..a.n {
+        for k in a.col_ptr[j]..a.col_ptr[j + 1] {
+            let i = a.row_idx[k] as usize;
+            let p = cursor[i];
+            if p >= a.col_ptr[i + 1] || a.row_idx[p] as usize != j {
+                return None;
+            }
+            mirror[k] = p;
+            cursor[i] += 1;
+        }
+    }
+    (0..a.n).all(|i| cursor[i] == a.col_ptr[i + 1]).then_some(mirror)
 }
 
 /// `Ok` if every entry of a solution is finite, else the singular-tangent error.
@@ -72,7 +109,45 @@ fn widen(a: &CscRef<'_>, rows: &mut Vec<usize>) {
 impl DirectSolver {
     /// Forget the symbolic analyses and the factor (the pattern changed).
     pub fn reset(&mut self) {
-        *self = Self::default();
+        // The buffers keep their capacity: the next pattern is of about the same size.
+        let scratch = std::mem::take(&mut self.scratch);
+        let mut factor = std::mem::take(&mut self.factor);
+        let mut scale = std::mem::take(&mut self.scale);
+        factor.clear();
+        scale.clear();
+        *self = Self {
+            scratch,
+            factor,
+            scale,
+            ..Self::default()
+        };
+    }
+
+    /// Whether `a` (of the kept pattern) is symmetric to round-off: every
+    /// |a_ij − a_ji| ≤ `tolerance` · √(|a_ii| |a_jj|), the scale a symmetric factorisation's
+    /// pivots work at, and no zero on the diagonal. `false` for a pattern that is not
+    /// structurally symmetric. O(non-zeros); the mirror positions are found once per pattern.
+    pub fn is_symmetric(&mut self, a: CscRef<'_>, tolerance: f64) -> bool {
+        let mirror = self.mirror.get_or_insert_with(|| mirror_positions(&a));
+        let Some(mirror) = mirror.as_ref() else {
+            return false;
+        };
+        let diagonal = &mut self.scale;
+        diagonal.clear();
+        diagonal.extend((0..a.n).map(|j| {
+            (a.col_ptr[j]..a.col_ptr[j + 1])
+                .find(|&k| mirror[k] == k)
+                .map_or(0.0, |k| a.values[k].abs().sqrt())
+        }));
+        if diagonal.iter().any(|&d| !(d > 0.0 && d.is_finite())) {
+            return false;
+        }
+        (0..a.n).all(|j| {
+            (a.col_ptr[j]..a.col_ptr[j + 1]).all(|k| {
+                let i = a.row_idx[k] as usize;
+                (a.values[k] - a.values[mirror[k]]).abs() <= tolerance * diagonal[i] * diagonal[j]
+            })
+        })
     }
 
     /// Non-zeros of the symmetric factor's symbolic structure (0 before any LDLᵀ/LLᵀ).
@@ -105,8 +180,27 @@ impl DirectSolver {
     }
 
     /// Solve with the factor of the last [`Self::factorize`]; an error if the solution is
-    /// not finite.
+    /// not finite. Allocates its work space (the multigrid's coarsest level, shared by
+    /// threads, solves so); [`Self::solve_in_place_reusing`] keeps it.
     pub fn solve_in_place(&self, rhs: &mut [f64]) -> Result<(), SolverError> {
+        let mut scratch = Vec::new();
+        self.solve_with(rhs, &mut scratch)
+    }
+
+    /// [`Self::solve_in_place`] with the solver's own work space (no allocation once it has
+    /// grown to the pattern's size).
+    pub fn solve_in_place_reusing(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let out = self.solve_with(rhs, &mut scratch);
+        self.scratch = scratch;
+        out
+    }
+
+    fn solve_with(
+        &self,
+        rhs: &mut [f64],
+        scratch: &mut Vec<std::mem::MaybeUninit<u8>>,
+    ) -> Result<(), SolverError> {
         let n = rhs.len();
         if n == 0 {
             return Ok(());
@@ -127,10 +221,7 @@ impl DirectSolver {
                     .as_ref()
                     .ok_or(SolverError::Usage("solve_factorized: not factorised"))?;
                 let par = faer::get_global_parallelism();
-                let scratch = symbolic.solve_in_place_scratch::<f64>(1, par);
-                let mut buf =
-                    MemBuffer::try_new(scratch).map_err(|e| SolverError::Factorisation(format!("{e:?}")))?;
-                let stack = MemStack::new(&mut buf);
+                let stack = stack_of(scratch, symbolic.solve_in_place_scratch::<f64>(1, par));
                 let mat = MatMut::from_column_major_slice_mut(rhs, n, 1);
                 if kind == Factorisation::Llt {
                     LltRef::new(symbolic, &self.factor).solve_in_place_with_conj(Conj::No, mat, par, stack)
@@ -169,9 +260,7 @@ impl DirectSolver {
         } else {
             symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default())
         };
-        let mut buf =
-            MemBuffer::try_new(scratch).map_err(|e| SolverError::Factorisation(format!("{e:?}")))?;
-        let stack = MemStack::new(&mut buf);
+        let stack = stack_of(&mut self.scratch, scratch);
         let side = Side::Lower;
         if ldlt {
             symbolic

@@ -11,13 +11,15 @@
 //! factorisation is repeated at each Newton iteration. [`LinearSolver::Iterative`] solves
 //! iteratively instead, preconditioned by the grid's multigrid ([`crate::solver::multigrid`]).
 //!
-//! The factorisation is LU by default. The tangent of a hyperelastic problem, and of
-//! associative perfect plasticity with its consistent tangent, is symmetric, so
-//! [`LinearSolver::Ldlt`] or [`LinearSolver::Llt`] may be chosen instead: they read only
-//! the lower triangle, need about half the fill and run several times faster (measured in
-//! `tests/verification/fem2d.rs`). If the symmetric factorisation fails (zero pivot; for LLT any matrix
-//! that is not numerically positive definite) or yields a non-finite solution, the same
-//! system is solved by LU and the fallback is counted ([`SparseSystem::fallbacks`]).
+//! The default, [`LinearSolver::Auto`], looks at each assembled matrix: symmetric to
+//! round-off (the tangents of hyperelasticity, of associative plasticity with its
+//! consistent tangent, and the ghost penalty), it is factorised by LDLᵀ, which reads the
+//! lower triangle, needs about half of LU's fill and ran 5.4 times faster on the
+//! compaction's tangents (reference/README.md item 64); otherwise by LU. [`LinearSolver::Lu`],
+//! [`LinearSolver::Ldlt`] and [`LinearSolver::Llt`] force one. If a symmetric factorisation
+//! fails (zero pivot; for LLᵀ any matrix that is not numerically positive definite), yields
+//! a non-finite solution or, under `Auto`, misses [`BACKWARD_ERROR_LIMIT`], the same system
+//! is solved by LU and the fallback is counted ([`SparseSystem::fallbacks`]).
 
 use crate::solver::direct::{DirectSolver, Factorisation};
 use crate::solver::error::SolverError;
@@ -31,8 +33,13 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LinearSolver {
-    /// General sparse LU (no symmetry assumed).
+    /// LDLᵀ when the assembled matrix is symmetric to round-off ([`SYMMETRY_TOLERANCE`]) and
+    /// the solve's backward error stays below [`BACKWARD_ERROR_LIMIT`], else LU: the
+    /// symmetric solve where it is exact, the general one where it is needed, decided per
+    /// matrix.
     #[default]
+    Auto,
+    /// General sparse LU (no symmetry assumed).
     Lu,
     /// Sparse LDLᵀ of the lower triangle (symmetric, possibly indefinite, no pivoting),
     /// LU on failure.
@@ -49,6 +56,16 @@ pub enum LinearSolver {
     #[serde(rename = "cg")]
     Iterative,
 }
+
+/// [`LinearSolver::Auto`] solves by LDLᵀ when every |K_ij − K_ji| ≤ this · √(|K_ii| |K_jj|).
+/// The symmetric tangents of the studies (elasticity, associative plasticity, the ghost
+/// penalty) differ from their transposes by round-off only, the non-symmetric ones by many
+/// orders more (reference/README.md item 64).
+pub const SYMMETRY_TOLERANCE: f64 = 1e-12;
+/// An LDLᵀ solve of [`LinearSolver::Auto`] is redone by LU when its backward error
+/// ‖b − K x‖∞ / (‖K‖∞ ‖x‖∞ + ‖b‖∞) exceeds this: LDLᵀ does not pivot, and a growing
+/// pivot on an indefinite tangent would show here (reference/README.md item 64).
+pub const BACKWARD_ERROR_LIMIT: f64 = 1e-12;
 
 /// Default relative tolerance of an iterative solve when no Newton solver has set one.
 pub const DEFAULT_ITERATIVE_TOLERANCE: f64 = 1e-10;
@@ -83,6 +100,8 @@ pub struct LinearStats {
     pub factor_nnz: usize,
     /// Multigrid hierarchies rebuilt because a kept one had become ineffective.
     pub rebuilds: usize,
+    /// Solves [`LinearSolver::Auto`] made by LDLᵀ (the others by LU).
+    pub symmetric_solves: usize,
     /// Solves that CG could not finish and GMRES took over (iterations of both counted).
     pub gmres_solves: usize,
 }
@@ -116,6 +135,10 @@ pub struct SparseSystem {
     /// The multigrid of an earlier matrix of this pattern and the CG iterations it took when
     /// fresh ([`Self::solve_cg`] reuses it).
     hierarchy: Option<(Box<Hierarchy>, usize)>,
+    /// The right-hand side of the solve under way, kept for a fallback or a residual check.
+    rhs: Vec<f64>,
+    /// K x of that check.
+    product: Vec<f64>,
 }
 
 impl std::ops::Deref for SparseSystem {
@@ -133,10 +156,13 @@ impl std::ops::DerefMut for SparseSystem {
 
 impl SparseSystem {
     /// Build the pattern from `columns[c]` = rows that may be non-zero in column `c`
-    /// (unsorted, duplicates allowed). Resets the cached factorisations and multigrid.
+    /// (unsorted, duplicates allowed). Resets the multigrid, and the cached factorisations
+    /// unless the pattern is the current one ([`SparseMatrix::set_pattern`]): a symbolic
+    /// analysis is a function of the pattern only.
     pub fn set_pattern(&mut self, columns: Vec<Vec<usize>>) {
-        self.matrix.set_pattern(columns);
-        self.direct.reset();
+        if self.matrix.set_pattern(columns) {
+            self.direct.reset();
+        }
         self.hierarchy = None;
     }
 
@@ -265,9 +291,15 @@ impl SparseSystem {
         Ok(())
     }
 
-    /// The direct factorisation of a direct solver choice (`None` for the iterative one).
-    fn factorisation(&self) -> Option<Factorisation> {
+    /// The direct factorisation of a direct solver choice (`None` for the iterative one);
+    /// [`LinearSolver::Auto`] looks at the current values.
+    fn factorisation(&mut self) -> Option<Factorisation> {
         match self.solver {
+            LinearSolver::Auto => Some(if self.is_symmetric() {
+                Factorisation::Ldlt
+            } else {
+                Factorisation::Lu
+            }),
             LinearSolver::Lu => Some(Factorisation::Lu),
             LinearSolver::Ldlt => Some(Factorisation::Ldlt),
             LinearSolver::Llt => Some(Factorisation::Llt),
@@ -283,30 +315,78 @@ impl SparseSystem {
         let kind = self.factorisation().ok_or(SolverError::Usage(
             "factorize: a direct solver only (LDLᵀ, LLᵀ or LU)",
         ))?;
-        let out = self.direct.factorize(self.matrix.csc().transpose_as_csc(), kind);
+        let mut out = self.direct.factorize(self.matrix.csc().transpose_as_csc(), kind);
+        if out.is_err() && self.solver == LinearSolver::Auto && kind != Factorisation::Lu {
+            self.fallbacks += 1;
+            out = self
+                .direct
+                .factorize(self.matrix.csc().transpose_as_csc(), Factorisation::Lu);
+        }
         self.stats.factor_nnz = self.direct.factor_nnz();
         out
     }
 
     /// Solve with the factor of the last [`Self::factorize`].
-    pub fn solve_factorized(&self, rhs: &mut [f64]) -> Result<(), SolverError> {
+    pub fn solve_factorized(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
         if self.matrix.dim() == 0 {
             return Ok(());
         }
-        self.direct.solve_in_place(rhs)
+        self.direct.solve_in_place_reusing(rhs)
     }
 
-    /// Factorise (set-up) and solve (solve), LU when a symmetric factorisation fails.
+    /// Whether the current matrix is symmetric to [`SYMMETRY_TOLERANCE`] (set-up time).
+    fn is_symmetric(&mut self) -> bool {
+        let start = std::time::Instant::now();
+        let symmetric = self
+            .direct
+            .is_symmetric(self.matrix.csc().transpose_as_csc(), SYMMETRY_TOLERANCE);
+        self.stats.charge(crate::solver::profile::Phase::Setup, start);
+        symmetric
+    }
+
+    /// ‖b − K x‖∞ / (‖K‖ ‖x‖∞ + ‖b‖∞) (‖K‖ the largest line sum) of the solution `x` of `K x = b`, b in `self.rhs`.
+    fn backward_error(&mut self, x: &[f64]) -> f64 {
+        self.product.resize(x.len(), 0.0);
+        self.matrix.mul_vec(x, &mut self.product);
+        let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        let residual = self
+            .product
+            .iter()
+            .zip(&self.rhs)
+            .fold(0.0f64, |m, (kx, b)| m.max((b - kx).abs()));
+        residual / (self.matrix.max_line_sum() * inf(x) + inf(&self.rhs))
+    }
+
+    /// Factorise (set-up) and solve (solve), LU when a symmetric factorisation fails (or,
+    /// for [`LinearSolver::Auto`], misses [`BACKWARD_ERROR_LIMIT`]).
     fn solve_direct(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
-        if self.solver != LinearSolver::Lu {
-            let original = rhs.to_vec();
-            match self.solve_symmetric(rhs) {
-                Ok(()) if rhs.iter().all(|v| v.is_finite()) => return Ok(()),
-                _ => {
-                    self.fallbacks += 1;
-                    rhs.copy_from_slice(&original);
+        let symmetric = match self.solver {
+            LinearSolver::Lu => None,
+            LinearSolver::Llt => Some(Factorisation::Llt),
+            LinearSolver::Auto => self.is_symmetric().then_some(Factorisation::Ldlt),
+            // The iterative strategy's last resort is LDLᵀ.
+            LinearSolver::Ldlt | LinearSolver::Iterative => Some(Factorisation::Ldlt),
+        };
+        if let Some(kind) = symmetric {
+            self.rhs.clear();
+            self.rhs.extend_from_slice(rhs);
+            match self.solve_symmetric(rhs, kind) {
+                Ok(()) if rhs.iter().all(|v| v.is_finite()) => {
+                    if self.solver != LinearSolver::Auto {
+                        return Ok(());
+                    }
+                    let start = std::time::Instant::now();
+                    let accurate = self.backward_error(rhs) <= BACKWARD_ERROR_LIMIT;
+                    self.stats.charge(crate::solver::profile::Phase::Solve, start);
+                    if accurate {
+                        self.stats.symmetric_solves += 1;
+                        return Ok(());
+                    }
                 }
+                _ => {}
             }
+            self.fallbacks += 1;
+            rhs.copy_from_slice(&self.rhs);
         }
         self.solve_lu(rhs)?;
         crate::solver::direct::finite(rhs)
@@ -326,19 +406,14 @@ impl SparseSystem {
     }
 
     /// LDLᵀ or LLᵀ of the lower triangle, then the solve.
-    fn solve_symmetric(&mut self, rhs: &mut [f64]) -> Result<(), SolverError> {
-        let kind = match self.solver {
-            LinearSolver::Llt => Factorisation::Llt,
-            // The iterative strategy's last resort is LDLᵀ.
-            _ => Factorisation::Ldlt,
-        };
+    fn solve_symmetric(&mut self, rhs: &mut [f64], kind: Factorisation) -> Result<(), SolverError> {
         let start = std::time::Instant::now();
         let factored = self.direct.factorize(self.matrix.csc().transpose_as_csc(), kind);
         self.stats.factor_nnz = self.direct.factor_nnz();
         self.stats.charge(crate::solver::profile::Phase::Setup, start);
         factored?;
         let start = std::time::Instant::now();
-        let solved = self.direct.solve_in_place(rhs);
+        let solved = self.direct.solve_in_place_reusing(rhs);
         self.stats.charge(crate::solver::profile::Phase::Solve, start);
         solved
     }
@@ -419,6 +494,80 @@ mod tests {
         // Asking the iterative strategy for a factorisation is the caller's mistake.
         sys.set_solver(LinearSolver::Iterative);
         assert!(matches!(sys.factorize(), Err(SolverError::Usage(_))));
+    }
+
+    /// The default solver takes LDLᵀ exactly where the matrix is symmetric to round-off and
+    /// its solve is accurate: a symmetric system goes to LDLᵀ; one entry changed by 1e-9 of
+    /// the diagonal's scale sends it to LU; a well-conditioned indefinite symmetric system whose
+    /// LDLᵀ pivots grow (δ = 1e-10 on the diagonal, 1 elsewhere: any first pivot is δ, the
+    /// growth 1/δ: a backward error of 2.9e-11, the solution off by 1.5e-10) passes as finite
+    /// but fails the backward-error check and is redone by LU. Every solution is LU's.
+    #[test]
+    fn auto_takes_ldlt_only_where_symmetric_and_accurate() {
+        let reference = |sys: &mut SparseSystem, rhs: &[f64]| solve(sys, LinearSolver::Lu, rhs);
+        let close = |x: &[f64], y: &[f64]| {
+            let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            x.iter().zip(y).all(|(a, b)| (a - b).abs() <= 1e-10 * scale)
+        };
+        let mut sys = laplacian(12, 0.5);
+        let n = sys.dim();
+        let rhs: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
+        let lu = reference(&mut sys, &rhs);
+        let x = solve(&mut sys, LinearSolver::Auto, &rhs);
+        assert!(close(&x, &lu));
+        assert_eq!((sys.stats().symmetric_solves, sys.fallbacks()), (1, 0));
+        // Not symmetric: K_01 = −1 + 4.5e-9 against K_10 = −1 (√(K_00 K_11) = 4.5).
+        sys.add(0, 1, 4.5e-9);
+        let lu = reference(&mut sys, &rhs);
+        let x = solve(&mut sys, LinearSolver::Auto, &rhs);
+        assert!(close(&x, &lu));
+        assert_eq!((sys.stats().symmetric_solves, sys.fallbacks()), (1, 0));
+        // Symmetric, but LDLᵀ without pivoting is unstable on it.
+        let delta = 1e-10;
+        let mut sys = SparseSystem::default();
+        sys.set_pattern(vec![vec![0, 1, 2]; 3]);
+        for r in 0..3 {
+            for c in 0..3 {
+                sys.add(r, c, if r == c { delta } else { 1.0 });
+            }
+        }
+        let rhs = [1.0, 2.0, 3.0];
+        let lu = reference(&mut sys, &rhs);
+        let x = solve(&mut sys, LinearSolver::Auto, &rhs);
+        assert!(close(&x, &lu), "{x:?} {lu:?}");
+        assert_eq!((sys.stats().symmetric_solves, sys.fallbacks()), (0, 1));
+    }
+
+    /// A pattern that is not structurally symmetric is never taken for symmetric, whatever
+    /// its values; the mirror positions of a symmetric one pair every entry.
+    #[test]
+    fn a_structurally_unsymmetric_pattern_is_not_symmetric() {
+        let mut sys = SparseSystem::default();
+        sys.set_pattern(vec![vec![0, 1], vec![1]]);
+        sys.add(0, 0, 2.0);
+        sys.add(1, 1, 2.0);
+        let x = solve(&mut sys, LinearSolver::Auto, &[2.0, 4.0]);
+        assert_eq!(x, vec![1.0, 2.0]);
+        assert_eq!(sys.stats().symmetric_solves, 0);
+        sys.set_pattern(vec![vec![0, 1], vec![0, 1]]);
+        sys.add(0, 0, 2.0);
+        sys.add(1, 1, 2.0);
+        let x = solve(&mut sys, LinearSolver::Auto, &[2.0, 4.0]);
+        assert_eq!(x, vec![1.0, 2.0]);
+        assert_eq!(sys.stats().symmetric_solves, 1);
+    }
+
+    /// Setting the current pattern again keeps it (and the symbolic analysis) but zeroes the
+    /// values; a different one replaces it.
+    #[test]
+    fn an_equal_pattern_is_kept_and_zeroed() {
+        let mut m = SparseMatrix::default();
+        assert!(m.set_pattern(vec![vec![1, 0], vec![0, 1, 1]]));
+        m.add(1, 0, 3.0);
+        assert!(!m.set_pattern(vec![vec![0, 1], vec![1, 0]]));
+        assert_eq!(m.get(1, 0), 0.0);
+        assert!(m.set_pattern(vec![vec![0], vec![1]]));
+        assert_eq!(m.nnz(), 2);
     }
 
     #[test]

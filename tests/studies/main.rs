@@ -5,6 +5,7 @@ mod bar_study;
 mod cantilever_dynamic_study;
 mod cantilever_study;
 mod column3d_study;
+mod committed_answers;
 mod compaction_reference_study;
 mod compaction_study;
 mod defects;

@@ -35,7 +35,7 @@ pub struct CompactionSpec {
     pub weak_node_treatment: WeakNodeTreatment,
     pub basis: Basis,
     pub domain_update: DomainUpdate,
-    /// Sparse factorisation; LDLᵀ suits this symmetric tangent (LU fallback).
+    /// Sparse factorisation; the default chooses LDLᵀ for the symmetric tangents (LU otherwise).
     #[serde(default)]
     pub linear_solver: LinearSolver,
     /// Ghost penalty of nearly empty cells ([`crate::discretise::ghost`]).
@@ -74,7 +74,7 @@ impl Default for CompactionSpec {
             weak_node_treatment: WeakNodeTreatment::Tie,
             basis: Basis::Gimp,
             domain_update: DomainUpdate::Stretch,
-            linear_solver: LinearSolver::Lu,
+            linear_solver: LinearSolver::Auto,
             // gamma: the plateau of the compaction study's ghost sweep: gamma in [0.1, 10] moves Figure 17 by <= 0.1 % at h <= 1/2.
             ghost: GhostSettings {
                 gamma: 1.0,

@@ -80,7 +80,7 @@ pub(crate) fn mpm_settings(spec: &ManufacturedSpec, method: Method) -> MpmSettin
         weak_node_tolerance: 0.0,
         weak_node_treatment: Default::default(),
         volume_update: Default::default(),
-        linear_solver: LinearSolver::Lu,
+        linear_solver: LinearSolver::Auto,
         ghost: Default::default(),
         dynamics: None,
     }
@@ -179,7 +179,7 @@ pub fn fem_solver(spec: &ManufacturedSpec, method: Method) -> Result<PlaneFem, I
         gauss_points: Some(gauss),
         newton: spec.newton,
         load_steps: spec.load_steps,
-        linear_solver: LinearSolver::Lu,
+        linear_solver: LinearSolver::Auto,
     };
     let model = spec.model()?;
     PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings)

@@ -4,6 +4,8 @@
 //! layers: [`crate::solver::direct`], [`crate::solver::krylov`], [`crate::solver::multigrid`] and the strategy of
 //! [`crate::solver::linear`] build on it, and it imports none of them.
 
+mod column_block;
+pub use column_block::ColumnBlock;
 use rayon::prelude::*;
 use std::sync::Arc;
 
@@ -42,15 +44,21 @@ pub struct CscRef<'a> {
 impl SparseMatrix {
     /// Build the pattern from `columns[c]` = rows that may be non-zero in column `c`
     /// (unsorted, duplicates allowed); the values are zeroed. The layout
-    /// ([`Self::set_by_rows`]) is kept.
-    pub fn set_pattern(&mut self, mut columns: Vec<Vec<usize>>) {
-        // The old pattern goes first, so that two never coexist.
-        self.stored = Csr::default();
+    /// ([`Self::set_by_rows`]) is kept. Returns whether the pattern changed: stored by
+    /// columns, a pattern equal entry for entry to the current one is kept (points that
+    /// moved to other nodes may still couple the same equations).
+    pub fn set_pattern(&mut self, mut columns: Vec<Vec<usize>>) -> bool {
         let n = columns.len();
         for col in columns.iter_mut() {
             col.sort_unstable();
             col.dedup();
         }
+        if !self.by_rows && self.same_columns(&columns) {
+            self.clear_values();
+            return false;
+        }
+        // The old pattern goes first, so that two never coexist.
+        self.stored = Csr::default();
         let mut ptr = vec![0usize; n + 1];
         if self.by_rows {
             for &r in columns.iter().flatten() {
@@ -85,6 +93,18 @@ impl SparseMatrix {
         }
         drop(columns);
         self.stored = Csr::new(n, n, ptr, idx, vec![0.0; nnz]);
+        true
+    }
+
+    /// Whether the stored columns (by columns) are `columns`, sorted and deduplicated.
+    fn same_columns(&self, columns: &[Vec<usize>]) -> bool {
+        let s = &self.stored;
+        s.rows == columns.len()
+            && s.ptr.len() == columns.len() + 1
+            && columns.iter().enumerate().all(|(c, col)| {
+                let stored = &s.idx[s.ptr[c]..s.ptr[c + 1]];
+                stored.len() == col.len() && stored.iter().zip(col).all(|(&a, &b)| a as usize == b)
+            })
     }
 
     /// Store by rows (`true`, for CG) or by columns (`false`, the default, for the direct
@@ -205,6 +225,16 @@ impl SparseMatrix {
     pub fn get(&self, row: usize, col: usize) -> f64 {
         self.find(row, col).map_or(0.0, |k| self.stored.val[k])
     }
+    /// The largest absolute sum of a stored line: ‖K‖₁ stored by columns, ‖K‖∞ by rows
+    /// (equal for a symmetric K, the matrices [`crate::solver::linear`]'s backward error is
+    /// measured on).
+    pub fn max_line_sum(&self) -> f64 {
+        let s = &self.stored;
+        (0..s.rows)
+            .map(|r| s.val[s.ptr[r]..s.ptr[r + 1]].iter().map(|v| v.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+    }
+
     /// `y = K x`.
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         if self.by_rows {
@@ -217,79 +247,6 @@ impl SparseMatrix {
                 y[s.idx[k] as usize] += s.val[k] * xc;
             }
         }
-    }
-}
-
-/// Entries [`ColumnBlock::stretch_with_hint`] scans forward before it searches: a 3D point's
-/// rows skip at most a few nodes' dofs of its column (27 nodes of 3 dofs in a GIMP stencil).
-/// Not tuned.
-const FORWARD_SCAN: usize = 32;
-
-/// A contiguous range of the stored lines of a [`SparseMatrix`] (columns, or rows when it
-/// is stored by rows) whose values one thread may update while other threads update other
-/// blocks. The names below say columns and rows for the column layout; by rows, they swap.
-pub struct ColumnBlock<'a> {
-    first_col: usize,
-    end_col: usize,
-    by_rows: bool,
-    col_ptr: &'a [usize],
-    row_idx: &'a [u32],
-    /// Values of columns `first_col..end_col`, starting at `col_ptr[first_col]`.
-    values: &'a mut [f64],
-}
-
-impl ColumnBlock<'_> {
-    /// The columns `first..end` this block owns.
-    #[inline]
-    pub fn columns(&self) -> (usize, usize) {
-        (self.first_col, self.end_col)
-    }
-    /// Whether the lines are K's rows: a dense block is then added transposed.
-    #[inline]
-    pub fn by_rows(&self) -> bool {
-        self.by_rows
-    }
-    /// Where column `col`'s entries start in the matrix's values (the positions
-    /// [`Self::stretch_with_hint`] takes and leaves are counted from the matrix's first entry).
-    #[inline]
-    pub fn column_start(&self, col: usize) -> usize {
-        self.col_ptr[col]
-    }
-    /// The values of rows `row..row + len` of an owned column, which the pattern must hold
-    /// as consecutive entries (a stretch of consecutive equations a point reaches), searched
-    /// forward from position `*hint`, which is left just past them. A point's stretches
-    /// ascend, and between two of them a column holds only the rows of the few nodes the
-    /// point skips, so a short scan finds the next one; a hint outside the column, past the
-    /// row, or more than `FORWARD_SCAN` entries short of it falls back to a binary search.
-    /// The position found is the same either way.
-    #[inline]
-    pub fn stretch_with_hint(&mut self, row: usize, col: usize, len: usize, hint: &mut usize) -> &mut [f64] {
-        let (a, b) = (self.col_ptr[col], self.col_ptr[col + 1]);
-        let row32 = column_index(row);
-        let mut k = *hint;
-        let found = if k >= a && k < b && self.row_idx[k] <= row32 {
-            let stop = (k + FORWARD_SCAN).min(b);
-            while k < stop && self.row_idx[k] < row32 {
-                k += 1;
-            }
-            k < b && self.row_idx[k] == row32
-        } else {
-            false
-        };
-        if !found {
-            k = match self.row_idx[a..b].binary_search(&row32) {
-                Ok(k) => a + k,
-                Err(_) => panic!("entry ({row}, {col}) is not in the sparsity pattern"),
-            };
-        }
-        assert!(
-            k + len <= b && self.row_idx[k + len - 1] as usize == row + len - 1,
-            "rows {row}..{} of column {col} are not all in the sparsity pattern",
-            row + len
-        );
-        *hint = k + len;
-        let offset = self.col_ptr[self.first_col];
-        &mut self.values[k - offset..k + len - offset]
     }
 }
 
