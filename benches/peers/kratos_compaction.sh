@@ -19,7 +19,7 @@ sizes=("$@")
 venv=${KRATOS_VENV:-$root/target/kratos-venv}
 out=$root/target/peers
 mkdir -p "$out"
-if ! "$venv/bin/python" -c "import KratosMultiphysics.MPMApplication" 2>/dev/null; then
+if ! "$venv/bin/python" -c "import KratosMultiphysics.MPMApplication" > /dev/null 2>&1; then
     echo "installing Kratos 10.4.4 into $venv" >&2
     python3 -m venv "$venv" && "$venv/bin/pip" install -q KratosMultiphysics==10.4.4 \
         KratosMPMApplication==10.4.4 KratosLinearSolversApplication==10.4.4 \

@@ -132,18 +132,20 @@ impl DirectSolver {
         let Some(mirror) = mirror.as_ref() else {
             return false;
         };
+        // The diagonal entry of column j is the one that is its own mirror; rows ascend, so
+        // the entries after it are the strictly lower ones, each compared with its mirror once.
+        let diagonal_at = |j: usize| (a.col_ptr[j]..a.col_ptr[j + 1]).find(|&k| mirror[k] == k);
         let diagonal = &mut self.scale;
         diagonal.clear();
-        diagonal.extend((0..a.n).map(|j| {
-            (a.col_ptr[j]..a.col_ptr[j + 1])
-                .find(|&k| mirror[k] == k)
-                .map_or(0.0, |k| a.values[k].abs().sqrt())
-        }));
-        if diagonal.iter().any(|&d| !(d > 0.0 && d.is_finite())) {
-            return false;
+        for j in 0..a.n {
+            match diagonal_at(j).map(|k| a.values[k].abs().sqrt()) {
+                Some(d) if d > 0.0 && d.is_finite() => diagonal.push(d),
+                _ => return false,
+            }
         }
         (0..a.n).all(|j| {
-            (a.col_ptr[j]..a.col_ptr[j + 1]).all(|k| {
+            let lower = a.row_idx[a.col_ptr[j]..a.col_ptr[j + 1]].partition_point(|&r| r as usize <= j);
+            (a.col_ptr[j] + lower..a.col_ptr[j + 1]).all(|k| {
                 let i = a.row_idx[k] as usize;
                 (a.values[k] - a.values[mirror[k]]).abs() <= tolerance * diagonal[i] * diagonal[j]
             })
