@@ -180,6 +180,11 @@ pub fn spatial_tangent_eigen<const D: usize>(
 ) -> Tensor4 {
     let theta = log_divided_differences(lam);
     let mut a = Tensor4::zeros();
+    // In 1D and 2D the eigenvectors of b keep the out-of-plane axes apart (`sym_eigen`'s
+    // exact block), so de vanishes outside its leading D × D block for in-plane k, l and the
+    // contraction with D^alg skips those zero terms (the same sums, but for signed zeros).
+    let block = (0..3).all(|r| (0..3).all(|c| (r < D) == (c < D) || q[(r, c)] == 0.0));
+    let dm = if block { D } else { 3 };
     for k in 0..D {
         for l in 0..D {
             let hat = Matrix3::from_fn(|x, y| {
@@ -192,8 +197,8 @@ pub fn spatial_tangent_eigen<const D: usize>(
             // order the row-by-row loop did, so the values are the same to the bit, and the
             // nine rows vectorise.
             let mut s = [0.0; 9];
-            for m in 0..3 {
-                for n in 0..3 {
+            for m in 0..dm {
+                for n in 0..dm {
                     let e = de[(m, n)];
                     let column = d_alg.fixed_view::<9, 1>(0, ij(m, n));
                     for (acc, d) in s.iter_mut().zip(column.iter()) {
