@@ -234,3 +234,47 @@ fn compaction_every_family_converges_to_the_q4_reference() {
         assert_eq!(c.pass, Some(true), "{c:#?}");
     }
 }
+
+/// A sweep that forces a factorisation names it in its case ids, so that it does not merge
+/// with the same cases by the default solver (before, `linear_solver = "lu"` gave the
+/// default's ids and one of the two sweeps was silently solved by the other's solver); `auto`
+/// is the default and names nothing; an unknown solver is refused naming the key.
+#[test]
+fn a_sweep_that_forces_a_solver_names_it_in_its_ids() {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/compaction.toml"))
+        .unwrap();
+    let fig17 = "[[sweeps]]\nid = \"fig17\"\n";
+    let with = |value: &str| {
+        let copy = format!("[[sweeps]]\nid = \"fig17-{value}\"\nlinear_solver = \"{value}\"\n");
+        let start = text.find(fig17).unwrap();
+        let end = start + text[start..].find("\n\n").unwrap();
+        let sweep = text[start..end].replacen(fig17, &copy, 1);
+        format!("{}\n{sweep}\n", text.trim_end())
+    };
+    for (value, suffix) in [
+        ("lu", "-lu"),
+        ("ldlt", "-ldlt"),
+        ("llt", "-llt"),
+        ("cg", "-cg"),
+        ("auto", ""),
+    ] {
+        let s = CompactionStudy::parse(&with(value), "compaction.toml").unwrap();
+        let (_, index) = s.cases(Tier::Quick);
+        let plain = &index["fig17"];
+        let forced = &index[&format!("fig17-{value}")];
+        assert_eq!(plain.len(), forced.len());
+        for (a, b) in plain.iter().zip(forced) {
+            let h = a.find("-p").unwrap_or(a.len());
+            let expected = if a.starts_with("fem") {
+                format!("{a}{suffix}")
+            } else {
+                format!("{}{suffix}{}", &a[..h], &a[h..])
+            };
+            assert_eq!(b, &expected, "{value}");
+        }
+    }
+    let err = CompactionStudy::parse(&with("gauss"), "compaction.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("linear_solver") && err.contains("gauss"), "{err}");
+}

@@ -91,8 +91,9 @@ pub struct CompactionSweep {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ghost_gammas: Option<Vec<f64>>,
     /// `cg`: the multigrid-preconditioned conjugate gradients ([`crate::solver::linear::LinearSolver::Iterative`]) for
-    /// every case of the sweep (ids gain `-cg`); absent: the direct default (LDLᵀ where the
-    /// tangent is symmetric to round-off, LU otherwise: reference/README.md item 64).
+    /// every case of the sweep (ids gain `-cg`); `lu`, `ldlt`, `llt`: that factorisation
+    /// (ids gain `-lu`, …); absent or `auto`: the direct default (LDLᵀ where the tangent is
+    /// symmetric to round-off, LU otherwise: reference/README.md item 64).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub linear_solver: Option<crate::solver::linear::LinearSolver>,
     #[serde(default)]

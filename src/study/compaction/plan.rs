@@ -302,8 +302,15 @@ impl CompactionStudy {
     pub(super) fn case_id(&self, method: Method, spec: &CompactionSpec) -> String {
         let material = material_tag(&spec.material);
         let mut id = format!("{}-{material}-h{}", method.name(), number(spec.element_size));
-        if spec.linear_solver == crate::solver::linear::LinearSolver::Iterative {
-            id.push_str("-cg");
+        // A solver other than the default names itself in the id, so that a sweep by LU
+        // beside the same cases by default is two sets of cases, not one.
+        use crate::solver::linear::LinearSolver;
+        match spec.linear_solver {
+            LinearSolver::Auto => {}
+            LinearSolver::Iterative => id.push_str("-cg"),
+            LinearSolver::Lu => id.push_str("-lu"),
+            LinearSolver::Ldlt => id.push_str("-ldlt"),
+            LinearSolver::Llt => id.push_str("-llt"),
         }
         if !method.is_fem() {
             id.push_str(&format!("-p{}", spec.points_per_cell));
