@@ -219,36 +219,42 @@ impl DofMap {
         // Neighbour nodes (with equations) of each node, sorted.
         let blocks = (rayon::current_num_threads() * 8).max(1);
         let block = num_nodes.div_ceil(blocks).max(1);
-        let neighbours: Vec<Vec<Vec<usize>>> = (0..num_nodes.div_ceil(block))
+        // Per block: its nodes' sorted neighbour lists, one after another, and where each ends.
+        let neighbours: Vec<(Vec<usize>, Vec<usize>)> = (0..num_nodes.div_ceil(block))
             .into_par_iter()
             .map(|b| {
                 let mut seen = vec![usize::MAX; num_nodes];
-                let mut out = vec![];
+                let (mut flat, mut ends) = (vec![], vec![]);
                 for n in b * block..((b + 1) * block).min(num_nodes) {
-                    let mut list = vec![];
+                    let first = flat.len();
                     if has_eq(n) {
                         for &p in &points[start[n]..start[n + 1]] {
                             for &m in table.point(p).0 {
                                 if seen[m] != n && has_eq(m) {
                                     seen[m] = n;
-                                    list.push(m);
+                                    flat.push(m);
                                 }
                             }
                         }
-                        list.sort_unstable();
+                        flat[first..].sort_unstable();
                     }
-                    out.push(list);
+                    ends.push(flat.len());
                 }
-                out
+                (flat, ends)
             })
             .collect();
         let mut columns: Vec<Vec<usize>> = vec![Vec::new(); self.count];
-        for (n, list) in neighbours.into_iter().flatten().enumerate() {
+        let lists = neighbours.iter().flat_map(|(flat, ends)| {
+            ends.iter().scan(0, move |first, &end| {
+                Some(&flat[std::mem::replace(first, end)..end])
+            })
+        });
+        for (n, list) in lists.enumerate() {
             for a in 0..D {
                 let Some(e) = self.eq[n * D + a] else { continue };
                 let col = &mut columns[e];
-                col.reserve(list.len() * D);
-                for &m in &list {
+                col.reserve_exact(list.len() * D);
+                for &m in list {
                     col.extend((0..D).filter_map(|b| self.eq[m * D + b]));
                 }
             }
