@@ -314,6 +314,10 @@ impl std::fmt::Display for PointError {
 /// pay for it.
 ///
 /// `grad_du` is ∂Δu/∂X̃ on the start-of-step configuration (eq 32).
+///
+/// Inlined into its callers so that the trial is built where they store it, not copied
+/// there (about 400 bytes a point; reference/README.md item 64).
+#[inline(always)]
 pub fn evaluate_point<const D: usize>(
     model: &dyn ConstitutiveModel,
     state: &PointState,
