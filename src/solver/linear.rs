@@ -307,7 +307,10 @@ impl SparseSystem {
         }
     }
 
-    /// Factorise (LDLᵀ, LLᵀ or LU) for later [`Self::solve_factorized`].
+    /// Factorise (LDLᵀ, LLᵀ or LU) for later [`Self::solve_factorized`]. Under
+    /// [`LinearSolver::Auto`] the choice is by symmetry alone (LU if LDLᵀ fails): the
+    /// backward-error check of [`Self::solve_in_place`] needs a right-hand side, which a
+    /// factorisation kept for later solves does not have.
     pub fn factorize(&mut self) -> Result<(), SolverError> {
         if self.matrix.dim() == 0 {
             return Ok(());
