@@ -115,6 +115,7 @@ pub fn time_iteration<const D: usize>(
         du_nodal: &mut du,
         ghost,
         fixed_forces: &mut Vec::new(),
+        prescribed: &[],
         linearised: None,
         inertia: None,
         dynamic_reference: None,

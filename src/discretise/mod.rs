@@ -6,3 +6,4 @@
 pub mod assembly;
 pub mod dofs;
 pub mod ghost;
+pub mod prescribed;

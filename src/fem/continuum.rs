@@ -306,6 +306,41 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
         )
     }
 
+    /// Prescribe the displacement of nodal dofs (node, axis, value at full load), following
+    /// `ramp` over the load steps: the dofs lose their equations (they join `fixed`) and every
+    /// step imposes its increment ([`crate::discretise::prescribed`]).
+    pub fn prescribe(
+        &mut self,
+        dofs: &[(usize, usize, f64)],
+        ramp: crate::solver::ramp::Ramp,
+    ) -> Result<(), InputError> {
+        ramp.validate("ramp")?;
+        let nn = self.mesh.num_nodes();
+        for &(n, a, v) in dofs {
+            if n >= nn || a >= D || !v.is_finite() {
+                return Err(InputError::new(
+                    "prescribed dof",
+                    format!("(node {n}, axis {a}, {v})"),
+                    format!("node < {nn}, axis < {D} and a finite value"),
+                ));
+            }
+        }
+        for &(n, a, _) in dofs {
+            self.fixed.push((n, a));
+            self.core.fixed_dofs.push((n, a));
+        }
+        self.core
+            .prescribed
+            .add(dofs.iter().map(|&(n, a, v)| (n * D + a, v)).collect(), ramp);
+        Ok(())
+    }
+
+    /// The reaction at a fixed or prescribed dof of the last converged step: the force the
+    /// support exerts on the body along `axis` at `node` ([`crate::discretise::assembly::StepWorkspace::reaction`]).
+    pub fn reaction(&self, node: usize, axis: usize) -> f64 {
+        self.core.work.reaction(node * D + axis)
+    }
+
     /// Displacement of node `n` since the start of the analysis.
     pub fn displacement(&self, n: usize) -> SVector<f64, D> {
         self.mesh.nodes[n] - self.mesh0.nodes[n]

@@ -109,8 +109,11 @@ pub(crate) struct FullLoads<'a, const D: usize> {
 /// workspace.
 pub(crate) struct UlCore<const D: usize> {
     pub model: Box<dyn ConstitutiveModel>,
-    /// Nodal dofs fixed at zero, as (node, axis).
+    /// Nodal dofs without an equation, as (node, axis): fixed at zero, or prescribed.
     pub fixed_dofs: Vec<(usize, usize)>,
+    /// Prescribed displacements (their dofs are in `fixed_dofs`) and the step's increments.
+    pub prescribed: crate::discretise::prescribed::PrescribedDisplacements,
+    prescribed_step: Vec<(usize, f64)>,
     pub step: usize,
     pub work: StepWorkspace<D>,
     /// Newmark time integration ([`crate::solver::dynamics`]); `None`: quasi-static.
@@ -137,6 +140,8 @@ impl<const D: usize> UlCore<D> {
         Self {
             model,
             fixed_dofs,
+            prescribed: Default::default(),
+            prescribed_step: vec![],
             step: 0,
             work: StepWorkspace {
                 fixed_pattern: true,
@@ -207,6 +212,7 @@ impl<const D: usize> UlCore<D> {
         load_factor: f64,
         f: impl FnOnce(&mut StepWorkspace<D>, &StepInput<'_, D>) -> R,
     ) -> Result<R, StepFailure> {
+        self.prescribed.increments(load_factor, &mut self.prescribed_step);
         let factor = self.prepare_motion(load_factor);
         // Dead loads: gravity m_q g mapped with N (eq 40) and nodal forces, both ∝ load factor.
         let mut forces: Vec<SVector<f64, D>> =
@@ -245,6 +251,7 @@ impl<const D: usize> UlCore<D> {
             num_nodes,
             fixed: &self.fixed_dofs,
             ties: &[],
+            prescribed: &self.prescribed_step,
             point_forces: &forces,
             nodal_forces: &nodal,
             ghost: None,
@@ -289,6 +296,7 @@ impl<const D: usize> UlCore<D> {
             .map_err(FailedAttempt::from)??;
         self.work.commit_states(states);
         self.commit_motion();
+        self.prescribed.commit(load_factor);
         Ok(Increment {
             newton: report,
             weak_nodes: 0,

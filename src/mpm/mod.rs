@@ -58,6 +58,8 @@ pub struct MpmSolver<const D: usize> {
     time: f64,
     /// A body force b₀(X, t) beside `loads` ([`Self::set_body_force`]).
     body_force: Option<BodyForce<D>>,
+    /// Prescribed nodal displacements ([`Self::prescribe`]).
+    prescribed: crate::discretise::prescribed::PrescribedDisplacements,
 }
 
 /// The grid's motion at the start of a dynamic step, projected from the points, and the
@@ -140,6 +142,7 @@ impl<const D: usize> MpmSolver<D> {
             nodal: NodalMotion::default(),
             time: 0.0,
             body_force: None,
+            prescribed: Default::default(),
         })
     }
 
@@ -164,6 +167,40 @@ impl<const D: usize> MpmSolver<D> {
     /// quasi-static analysis).
     pub fn set_body_force(&mut self, body_force: BodyForce<D>) {
         self.body_force = Some(body_force);
+    }
+
+    /// Prescribe the displacement of grid dofs (node, axis, value at full load), following
+    /// `ramp` over the load steps: the dofs join the fixed ones and every step moves them by
+    /// their increment ([`crate::discretise::prescribed`]). The grid is reset every step, so a
+    /// node prescribes the motion of whatever material its weights reach in that step: a
+    /// platen on a row of nodes is exact only while the body's face lies on that row
+    /// (reference/README.md item 66).
+    pub fn prescribe(
+        &mut self,
+        dofs: &[(usize, usize, f64)],
+        ramp: crate::solver::ramp::Ramp,
+    ) -> Result<(), InputError> {
+        ramp.validate("ramp")?;
+        let nn = self.grid.num_nodes();
+        for &(n, a, v) in dofs {
+            if n >= nn || a >= D || !v.is_finite() {
+                return Err(InputError::new(
+                    "prescribed dof",
+                    format!("(node {n}, axis {a}, {v})"),
+                    format!("node < {nn}, axis < {D} and a finite value"),
+                ));
+            }
+        }
+        self.fixed.extend(dofs.iter().map(|&(n, a, _)| (n, a)));
+        self.prescribed
+            .add(dofs.iter().map(|&(n, a, v)| (n * D + a, v)).collect(), ramp);
+        Ok(())
+    }
+
+    /// The reaction at a fixed or prescribed dof of the last converged step: the force the
+    /// support exerts on the body along `axis` at `node` ([`crate::discretise::assembly::StepWorkspace::reaction`]).
+    pub fn reaction(&self, node: usize, axis: usize) -> f64 {
+        self.work.reaction(node * D + axis)
     }
 
     /// The solver with a basis family of the caller's instead of `settings.basis`'s (e.g. one

@@ -16,6 +16,8 @@ struct PreparedStep<const D: usize> {
     forces: Vec<SVector<f64, D>>,
     fixed: Vec<(usize, usize)>,
     ties: Vec<(usize, usize)>,
+    /// The step's increments of the prescribed dofs.
+    prescribed: Vec<(usize, f64)>,
     weak_nodes: usize,
     /// The time step of a dynamic analysis.
     time_step: Option<TimeStep>,
@@ -32,6 +34,7 @@ impl<const D: usize> MpmSolver<D> {
             num_nodes: self.grid.num_nodes(),
             fixed: &step.fixed,
             ties: &step.ties,
+            prescribed: &step.prescribed,
             point_forces: &step.forces,
             nodal_forces: &[],
             ghost: self.settings.ghost.is_on().then_some(&self.ghost),
@@ -97,10 +100,13 @@ impl<const D: usize> MpmSolver<D> {
         if let Some(t) = &time_step {
             self.project_motion(&t.newmark, &fixed);
         }
+        let mut prescribed = vec![];
+        self.prescribed.increments(load_factor, &mut prescribed);
         Ok(PreparedStep {
             forces,
             fixed,
             ties,
+            prescribed,
             weak_nodes: weak.len(),
             time_step,
             start_forces,
@@ -141,6 +147,7 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
         if let Some(t) = step.time_step {
             self.time = t.end;
         }
+        self.prescribed.commit(load_factor);
         Ok(Increment {
             newton: report,
             weak_nodes: step.weak_nodes,

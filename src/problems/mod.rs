@@ -11,3 +11,4 @@ pub mod manufactured;
 pub mod manufactured3d;
 pub mod manufactured_dynamic;
 pub mod norms;
+pub mod scene;

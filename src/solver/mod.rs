@@ -14,4 +14,5 @@ pub mod multigrid;
 pub mod newton;
 pub mod norms;
 pub mod profile;
+pub mod ramp;
 pub mod sparse;

@@ -12,6 +12,7 @@ use crate::study::engine::{self, RunOptions, StudyKind};
 use crate::study::manufactured::ManufacturedStudy;
 use crate::study::render::{self, IndexEntry, Rendered};
 use crate::study::results::{problem_of_results, problem_of_study, RunSummary};
+use crate::study::scene::SceneStudy;
 use crate::study::{StudyError, Tier};
 use std::path::{Path, PathBuf};
 
@@ -22,6 +23,7 @@ pub const KINDS: &[Kind] = &[
     Kind::of::<CantileverStudy>(render::cantilever::render, render::cantilever::index_entry),
     Kind::of::<ManufacturedStudy>(render::manufactured::render, render::manufactured::index_entry),
     Kind::of::<DynamicStudy>(render::dynamics::render, render::dynamics::index_entry),
+    Kind::of::<SceneStudy>(render::scene::render, render::scene::index_entry),
 ];
 
 /// What `study` asks of one study file.

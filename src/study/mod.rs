@@ -28,6 +28,7 @@ pub mod methods;
 pub mod render;
 pub mod replace;
 pub mod results;
+pub mod scene;
 pub mod store;
 pub mod vocabulary;
 pub mod vtk;

@@ -17,6 +17,7 @@ mod manufactured_study;
 mod performance;
 mod reliability;
 mod resume;
+mod scene_study;
 mod schema_doc;
 mod study;
 mod three_d_studies;

@@ -31,4 +31,5 @@ mod multigrid;
 mod patch;
 mod plasticity;
 mod robustness;
+mod scene;
 mod tangent;

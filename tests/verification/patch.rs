@@ -57,6 +57,7 @@ fn patch<const D: usize>(
         du_nodal: &mut du,
         ghost: None,
         fixed_forces: &mut Vec::new(),
+        prescribed: &[],
         linearised: None,
         inertia: None,
         dynamic_reference: None,

@@ -165,6 +165,7 @@ fn assembled_at<const D: usize, R>(
         du_nodal: &mut du,
         ghost: ghost.as_ref(),
         fixed_forces: &mut Vec::new(),
+        prescribed: &[],
         linearised: None,
         inertia: None,
         dynamic_reference: None,

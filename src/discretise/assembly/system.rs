@@ -38,6 +38,8 @@ pub struct LoadStepSystem<'a, const D: usize> {
     /// Internal force at the dofs without an equation (fixed ones: the support reactions
     /// plus the external force there), indexed by nodal dof, at the last evaluation.
     pub fixed_forces: &'a mut Vec<f64>,
+    /// The step's increments of prescribed dofs (dof, Δu): every evaluation imposes them.
+    pub prescribed: &'a [(usize, f64)],
     /// Linearised reaction update ([`ResidualNorm::Linearised`]); `None`: not tracked.
     pub linearised: Option<&'a mut LinearisedReactions>,
     /// The inertia term M a₁(Δu) of a dynamic step ([`crate::solver::dynamics`]); `None`: static.
@@ -239,6 +241,11 @@ impl<const D: usize> NonlinearSystem for LoadStepSystem<'_, D> {
     fn evaluate(&mut self, u: &[f64], residual: &mut [f64]) -> Result<(), StepFailure> {
         self.du_nodal.resize(self.dofs.num_dofs(), 0.0);
         self.dofs.expand(u, self.du_nodal);
+        // Prescribed dofs have no equation, so `expand` left them at 0; a dof in two groups
+        // takes both increments.
+        for &(dof, du) in self.prescribed {
+            self.du_nodal[dof] += du;
+        }
         self.assemble_residual(residual)?;
         for (r, f) in residual.iter_mut().zip(self.f_ext) {
             *r -= f;

@@ -31,6 +31,8 @@ pub struct StepWorkspace<const D: usize> {
     pub du_nodal: Vec<f64>,
     /// Internal force at the fixed dofs at the last evaluation (see [`LoadStepSystem`]).
     pub fixed_forces: Vec<f64>,
+    /// The step's external force at every nodal dof (dof = node·D + axis).
+    pub external_nodal: Vec<f64>,
     /// Linearised reactions ([`ResidualNorm::Linearised`]).
     pub linearised: LinearisedReactions,
     /// Where the nodes sit, for an iterative solver's multigrid
@@ -57,6 +59,9 @@ pub struct StepInput<'a, const D: usize> {
     pub fixed: &'a [(usize, usize)],
     /// Nodes tied to a master node (slave, master): u_slave = u_master.
     pub ties: &'a [(usize, usize)],
+    /// The step's increments of prescribed dofs (dof = node·D + axis, Δu), each also in
+    /// `fixed` ([`crate::discretise::prescribed`]).
+    pub prescribed: &'a [(usize, f64)],
     /// Force carried by each point (body force × mass, point loads), mapped with the weights (eq 40).
     pub point_forces: &'a [SVector<f64, D>],
     /// Forces applied directly to nodal dofs (dof = node·D + axis).
@@ -86,14 +91,16 @@ fn external_force<const D: usize>(
     dofs: &DofMap,
     point_forces: &[SVector<f64, D>],
     nodal_forces: &[(usize, f64)],
+    nodal: &mut Vec<f64>,
 ) -> Vec<f64> {
-    let mut nodal = vec![0.0; dofs.num_dofs()];
-    map_point_forces(table, point_forces, &mut nodal);
+    nodal.clear();
+    nodal.resize(dofs.num_dofs(), 0.0);
+    map_point_forces(table, point_forces, nodal);
     for &(dof, force) in nodal_forces {
         nodal[dof] += force;
     }
     let mut f_ext = vec![0.0; dofs.len()];
-    dofs.gather_forces(&nodal, &mut f_ext);
+    dofs.gather_forces(nodal, &mut f_ext);
     f_ext
 }
 
@@ -148,13 +155,25 @@ impl<const D: usize> StepWorkspace<D> {
             }
         }
         crate::solver::profile::charge(crate::solver::profile::Phase::Setup, start);
-        let mut f_ext = external_force(&self.table, &dofs, input.point_forces, input.nodal_forces);
+        let mut f_ext = external_force(
+            &self.table,
+            &dofs,
+            input.point_forces,
+            input.nodal_forces,
+            &mut self.external_nodal,
+        );
         if let (Some(i), Some(start)) = (input.inertia, input.start_forces) {
             let weight = i.step.start_force_weight();
             if weight != 0.0 {
                 // f_ext(t₁) − c_f (f_int(u₀) − f_ext(t₀)): f_int(u₀) is the internal force at a
                 // zero increment (the committed stresses on this step's grid or mesh).
-                let f_ext0 = external_force(&self.table, &dofs, start.point_forces, start.nodal_forces);
+                let f_ext0 = external_force(
+                    &self.table,
+                    &dofs,
+                    start.point_forces,
+                    start.nodal_forces,
+                    &mut Vec::new(),
+                );
                 let mut f_int0 = vec![0.0; dofs.len()];
                 self.du_nodal.clear();
                 self.du_nodal.resize(dofs.num_dofs(), 0.0);
@@ -169,6 +188,7 @@ impl<const D: usize> StepWorkspace<D> {
                     du_nodal: &mut self.du_nodal,
                     ghost: input.ghost,
                     fixed_forces: &mut self.fixed_forces,
+                    prescribed: &[],
                     linearised: None,
                     inertia: None,
                     dynamic_reference: None,
@@ -220,6 +240,7 @@ impl<const D: usize> StepWorkspace<D> {
             du_nodal: &mut self.du_nodal,
             ghost: input.ghost,
             fixed_forces: &mut self.fixed_forces,
+            prescribed: input.prescribed,
             linearised: track.then_some(&mut self.linearised),
             inertia: input.inertia,
             dynamic_reference: reference.as_ref().map(|(load, start)| DynamicReference {
@@ -258,6 +279,14 @@ impl<const D: usize> StepWorkspace<D> {
             },
             iterations: self.matrix.stats().iterations - iterations_before,
         }
+    }
+
+    /// The reaction at fixed dof `dof` (node·D + axis) of the last evaluation: the force the
+    /// support exerts on the body, f_int − f_ext there (inertia and ghost terms included in
+    /// f_int). Meaningful at fixed and prescribed dofs only; 0 before any step.
+    pub fn reaction(&self, dof: usize) -> f64 {
+        self.fixed_forces.get(dof).copied().unwrap_or(0.0)
+            - self.external_nodal.get(dof).copied().unwrap_or(0.0)
     }
 
     /// Replace each point's state (the step's start) by the converged step's.

@@ -11,6 +11,7 @@ pub mod manufactured;
 pub mod methods;
 pub mod plot;
 pub mod plot2d;
+pub mod scene;
 
 use crate::study::checks::{check_counts, CheckRecord, GciRecord};
 use crate::study::results::{write_text, CaseRecordOf, CaseStatus, FailureRecord, Timing};

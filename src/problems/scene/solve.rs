@@ -1,0 +1,582 @@
+//! A scene solved by one method: the grid and points (or the mesh) built from its bodies, the
+//! supports and displacement loads turned into node dofs, gravity and the ramps applied, the
+//! load steps run, and the measures read after every step.
+
+use super::spec::{axis_index, region, LoadKind, MeasureKind, Region, Scene};
+use crate::basis::method::Method;
+use crate::basis::{Basis, DomainUpdate};
+use crate::discretise::ghost::GhostSettings;
+use crate::fem::{
+    ContinuumFem, ElementFamily, ElementMesh, FemLoads, HexElement, HexMesh, PlaneFemSettings, PlaneMesh,
+    QuadElement,
+};
+use crate::material::kinematics::PointState;
+use crate::mesh::grid::Grid;
+use crate::mpm::particles::MaterialPoints;
+use crate::mpm::{Loads, MpmSettings, MpmSolver};
+use crate::solver::dynamics::BodyForce;
+use crate::solver::error::{InputError, SolveError};
+use crate::solver::linear::LinearSolver;
+use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
+use crate::solver::newton::NewtonSettings;
+use crate::solver::ramp::Ramp;
+use nalgebra::SVector;
+use serde::{Deserialize, Serialize};
+
+/// How one case solves a scene besides its method.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSettings {
+    /// Element size h: the grid's cells (cubes of h) and the FEM mesh's elements.
+    pub element_size: f64,
+    /// Material points per cell along each axis (material point methods).
+    pub points_per_cell: usize,
+    pub load_steps: usize,
+    pub newton: NewtonSettings,
+    pub ghost: GhostSettings,
+    pub domain_update: DomainUpdate,
+    pub linear_solver: LinearSolver,
+}
+
+/// One measure of a solved case: its final value and, if asked, its value after every step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeasureValue {
+    pub name: String,
+    pub value: f64,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub history: Vec<f64>,
+}
+
+/// Final state of one material point or Gauss point (ParaView).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointRecord {
+    pub x0: [f64; 3],
+    pub x: [f64; 3],
+    pub half0: [f64; 3],
+    pub half: [f64; 3],
+    /// Cauchy stress σ along the last axis.
+    pub sigma: f64,
+}
+
+/// What a scene case gives.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneOutcome {
+    pub steps: Vec<StepReport>,
+    pub failure: Option<SolveError>,
+    /// The measures at the last converged step (in the scene's order), and their histories.
+    pub measures: Vec<MeasureValue>,
+    /// Material points or elements.
+    pub size: usize,
+    /// Material points' final domains (none for FEM).
+    pub points: Vec<PointRecord>,
+}
+
+/// The methods of a scene in `dimension`.
+pub fn methods(dimension: usize) -> &'static [Method] {
+    // Every family, and the plane (solid) elements: the compaction's set.
+    crate::problems::compaction::methods(dimension)
+}
+
+/// Solve `scene` by `method` with `settings`. Errors are the case's input errors (a region
+/// on no node at this h, a body off the point lattice, a method the scene cannot use).
+pub fn solve(scene: &Scene, settings: &SceneSettings, method: Method) -> Result<SceneOutcome, InputError> {
+    scene.validate()?;
+    match (scene.dimension, method) {
+        (2, Method::MaterialPoint(b)) => solve_mpm::<2>(scene, settings, b),
+        (3, Method::MaterialPoint(b)) => solve_mpm::<3>(scene, settings, b),
+        (2, Method::FEM_Q4) => solve_fem::<2, _>(scene, settings, |o, s, c| {
+            PlaneMesh::structured(o, s, c, QuadElement::Q4)
+        }),
+        (2, Method::FEM_Q8) => solve_fem::<2, _>(scene, settings, |o, s, c| {
+            PlaneMesh::structured(o, s, c, QuadElement::Q8)
+        }),
+        (3, Method::FEM_HEX8) => solve_fem::<3, _>(scene, settings, |o, s, c| {
+            HexMesh::cuboid(o, s, c, HexElement::Hex8)
+        }),
+        (3, Method::FEM_HEX20) => solve_fem::<3, _>(scene, settings, |o, s, c| {
+            HexMesh::cuboid(o, s, c, HexElement::Hex20)
+        }),
+        (d, m) => Err(m.unsupported(&format!("a scene in dimension {d}"), methods(d))),
+    }
+}
+
+/// Cells of `length` at `h`, which must divide it.
+fn cells(key: &str, length: f64, h: f64) -> Result<usize, InputError> {
+    let n = length / h;
+    if !(n.is_finite()
+        && (n - n.round()).abs() <= 1e-9 * n.max(1.0)
+        && n.round() >= 1.0
+        && n.round() <= 100_000.0)
+    {
+        return Err(InputError::new(
+            key,
+            length,
+            format!("must be a whole multiple (1 to 100000) of the element size {h}"),
+        ));
+    }
+    Ok(n.round() as usize)
+}
+
+fn fixed_array<const D: usize>(v: &[f64]) -> [f64; D] {
+    std::array::from_fn(|a| v[a])
+}
+
+/// The node dofs (node, axis, value) of every support (value 0) and displacement load, by
+/// the name of its region, from the nodes' positions: an error names a region on no node.
+/// Calls its argument with every node and its position.
+type NodeVisitor<'a> = &'a dyn Fn(&mut dyn FnMut(usize, &[f64]));
+
+/// The reaction component `axis` summed over the (node, axis) dofs of a region.
+type ReactionSum<'a> = &'a dyn Fn(&[(usize, usize)], usize) -> f64;
+
+type NamedDofs = Vec<(
+    String,
+    Vec<(usize, usize)>,
+    Option<(Vec<(usize, usize, f64)>, Ramp)>,
+)>;
+
+fn region_dofs(scene: &Scene, h: f64, positions: NodeVisitor<'_>) -> Result<NamedDofs, InputError> {
+    let tol = 1e-9 * h;
+    let d = scene.dimension;
+    let nodes_in = |key: &str, r: Region<'_>| -> Result<Vec<usize>, InputError> {
+        let mut found = vec![];
+        positions(&mut |n, x| {
+            if r.holds(x, tol) {
+                found.push(n)
+            }
+        });
+        if found.is_empty() {
+            return Err(InputError::new(
+                key,
+                "no node",
+                format!("must hold at least one node at h = {h}"),
+            ));
+        }
+        Ok(found)
+    };
+    let mut out = vec![];
+    for (i, s) in scene.supports.iter().enumerate() {
+        let key = format!("supports[{i}]");
+        let nodes = nodes_in(&key, region(&key, &s.plane, &s.bounds, d)?)?;
+        let mut dofs = vec![];
+        for (j, c) in s.fix.iter().enumerate() {
+            let a = axis_index(&format!("{key}.fix[{j}]"), c, d)?;
+            dofs.extend(nodes.iter().map(|&n| (n, a)));
+        }
+        out.push((s.name.clone(), dofs, None));
+    }
+    for (i, l) in scene.loads.iter().enumerate() {
+        if l.kind != LoadKind::Displacement {
+            continue;
+        }
+        let key = format!("loads[{i}]");
+        let nodes = nodes_in(&key, region(&key, &l.plane, &l.bounds, d)?)?;
+        let given = l.displacement.as_ref().map(|c| c.given()).unwrap_or_default();
+        let mut dofs = vec![];
+        let mut values = vec![];
+        for &(a, v) in &given {
+            dofs.extend(nodes.iter().map(|&n| (n, a)));
+            values.extend(nodes.iter().map(|&n| (n, a, v)));
+        }
+        out.push((
+            l.name.clone().unwrap_or_default(),
+            dofs,
+            Some((values, l.ramp.clone())),
+        ));
+    }
+    Ok(out)
+}
+
+/// Σ of the gravity loads with a linear ramp, and those with a table.
+fn gravity<const D: usize>(scene: &Scene) -> (SVector<f64, D>, Vec<(SVector<f64, D>, Ramp)>) {
+    let mut linear = SVector::<f64, D>::zeros();
+    let mut tabled = vec![];
+    for l in scene.loads.iter().filter(|l| l.kind == LoadKind::Gravity) {
+        let g = SVector::<f64, D>::from_iterator(l.vector.iter().flatten().copied());
+        match l.ramp {
+            Ramp::Linear => linear += g,
+            _ => tabled.push((g, l.ramp.clone())),
+        }
+    }
+    (linear, tabled)
+}
+
+/// The body force ρ₀ g f(t) of the tabled gravity loads, ρ₀ the density of the body holding X.
+fn tabled_body_force<const D: usize>(
+    scene: &Scene,
+    tabled: Vec<(SVector<f64, D>, Ramp)>,
+) -> Option<BodyForce<D>> {
+    if tabled.is_empty() {
+        return None;
+    }
+    let bodies: Vec<_> = scene
+        .bodies
+        .iter()
+        .map(|b| (b.bounds.clone(), b.density))
+        .collect();
+    Some(BodyForce::new(move |x: &SVector<f64, D>, t: f64| {
+        let rho = bodies
+            .iter()
+            .find(|(b, _)| b.contains(x.as_slice(), 1e-12))
+            .map_or(0.0, |(_, r)| *r);
+        tabled.iter().map(|(g, r)| g * (rho * r.factor(t))).sum()
+    }))
+}
+
+/// Hencky stored energy V₀ W(εᵉ) of one point.
+fn energy(state: &PointState, volume0: f64, young: f64, poisson: f64) -> f64 {
+    let mu = young / (2.0 * (1.0 + poisson));
+    let lambda = young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson));
+    let e = &state.material.eps_e;
+    volume0 * (mu * e.component_mul(e).sum() + 0.5 * lambda * e.trace().powi(2))
+}
+
+/// What the measures read from a solver.
+struct Probe<'a> {
+    displacement: &'a dyn Fn(&[f64], usize, bool) -> f64,
+    reaction: ReactionSum<'a>,
+    energy: &'a dyn Fn(f64, f64) -> f64,
+}
+
+/// Every measure of `scene` from `probe`, with the region dofs `named`.
+fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>) -> Vec<f64> {
+    scene
+        .measures
+        .iter()
+        .map(|m| {
+            let axis = m
+                .component
+                .as_ref()
+                .and_then(|c| axis_index("", c, scene.dimension).ok())
+                .unwrap_or(0);
+            match m.kind {
+                MeasureKind::Displacement => {
+                    (probe.displacement)(m.at.as_deref().unwrap_or(&[]), axis, m.domain_edge)
+                }
+                MeasureKind::Reaction => {
+                    let dofs = named
+                        .iter()
+                        .find(|n| Some(&n.0) == m.region.as_ref())
+                        .map_or(&[][..], |n| &n.1[..]);
+                    (probe.reaction)(dofs, axis)
+                }
+                MeasureKind::StrainEnergy => {
+                    let (e, nu) = scene.hencky_parameters("").unwrap_or((f64::NAN, f64::NAN));
+                    (probe.energy)(e, nu)
+                }
+            }
+        })
+        .collect()
+}
+
+/// The measures after the run: final values and the histories asked for.
+fn gather(scene: &Scene, history: Vec<Vec<f64>>, last: Vec<f64>) -> Vec<MeasureValue> {
+    scene
+        .measures
+        .iter()
+        .enumerate()
+        .map(|(k, m)| MeasureValue {
+            name: m.name.clone(),
+            value: last[k],
+            history: if m.history {
+                history.iter().map(|h| h[k]).collect()
+            } else {
+                vec![]
+            },
+        })
+        .collect()
+}
+
+fn pad<const D: usize>(v: &SVector<f64, D>) -> [f64; 3] {
+    std::array::from_fn(|a| if a < D { v[a] } else { 0.0 })
+}
+
+fn solve_mpm<const D: usize>(
+    scene: &Scene,
+    s: &SceneSettings,
+    basis: Basis,
+) -> Result<SceneOutcome, InputError> {
+    let h = s.element_size;
+    let mut n = [0; D];
+    for a in 0..D {
+        n[a] = cells(&format!("grid.extent[{a}]"), scene.grid.extent[a], h)?;
+    }
+    let grid = Grid::try_new(fixed_array::<D>(&scene.grid.origin), [h; D], n)?;
+    let mut points: Option<MaterialPoints<D>> = None;
+    for b in &scene.bodies {
+        let filled = MaterialPoints::fill_box(
+            &grid,
+            fixed_array::<D>(&b.bounds.min),
+            fixed_array::<D>(&b.bounds.max),
+            [s.points_per_cell; D],
+            b.density,
+        )?;
+        match &mut points {
+            None => points = Some(filled),
+            Some(all) => {
+                for p in 0..filled.len() {
+                    all.push(filled.position[p], filled.half_length[p], b.density);
+                }
+            }
+        }
+    }
+    let points = points.expect("a scene has a body");
+    let named = region_dofs(scene, h, &|f| {
+        for k in 0..grid.num_nodes() {
+            f(k, grid.node_position(k).as_slice())
+        }
+    })?;
+    let (g, tabled) = gravity::<D>(scene);
+    let fixed: Vec<(usize, usize)> = named
+        .iter()
+        .filter(|n| n.2.is_none())
+        .flat_map(|n| n.1.iter().copied())
+        .collect();
+    let settings = MpmSettings {
+        basis,
+        domain_update: s.domain_update,
+        newton: s.newton,
+        load_steps: s.load_steps,
+        weak_node_tolerance: 0.0,
+        weak_node_treatment: Default::default(),
+        volume_update: Default::default(),
+        linear_solver: s.linear_solver,
+        ghost: s.ghost,
+        dynamics: None,
+    };
+    let model = scene.materials[&scene.bodies[0].material].build()?;
+    let loads = Loads {
+        gravity: g,
+        point_loads: vec![],
+    };
+    let mut solver = MpmSolver::try_new(grid, points, model, fixed, loads, settings)?;
+    if let Some(b) = tabled_body_force(scene, tabled) {
+        solver.set_body_force(b);
+    }
+    for (_, _, p) in &named {
+        if let Some((values, ramp)) = p {
+            solver.prescribe(values, ramp.clone())?;
+        }
+    }
+    let measure = |solver: &MpmSolver<D>| {
+        let pts = &solver.points;
+        let displacement = |at: &[f64], axis: usize, edge: bool| {
+            let at = SVector::<f64, D>::from_iterator(at.iter().copied());
+            let p = (0..pts.len())
+                .min_by(|&a, &b| {
+                    (pts.position0[a] - at)
+                        .norm_squared()
+                        .total_cmp(&(pts.position0[b] - at).norm_squared())
+                })
+                .expect("points");
+            let grow = if edge {
+                (pts.half_length[p][axis] - pts.half_length0[p][axis])
+                    * (at[axis] - pts.position0[p][axis]).signum()
+            } else {
+                0.0
+            };
+            pts.displacement(p)[axis] + grow
+        };
+        let reaction = |dofs: &[(usize, usize)], axis: usize| {
+            dofs.iter()
+                .filter(|d| d.1 == axis)
+                .map(|&(n, a)| solver.reaction(n, a))
+                .sum()
+        };
+        let energy = |e: f64, nu: f64| {
+            (0..pts.len())
+                .map(|p| energy(&pts.state[p], pts.volume0[p], e, nu))
+                .sum()
+        };
+        read_measures(
+            scene,
+            &named,
+            &Probe {
+                displacement: &displacement,
+                reaction: &reaction,
+                energy: &energy,
+            },
+        )
+    };
+    let mut history = vec![];
+    let run = solver.run_observed(&mut |solver, _| history.push(measure(solver)));
+    let (steps, failure) = steps_and_failure(run);
+    let last = measure(&solver);
+    let pts = &solver.points;
+    let points = (0..pts.len())
+        .map(|p| PointRecord {
+            x0: pad(&pts.position0[p]),
+            x: pad(&pts.position[p]),
+            half0: pad(&pts.half_length0[p]),
+            half: pad(&pts.half_length[p]),
+            sigma: pts.state[p].cauchy()[(D - 1, D - 1)],
+        })
+        .collect();
+    Ok(SceneOutcome {
+        steps,
+        failure,
+        measures: gather(scene, history, last),
+        size: pts.len(),
+        points,
+    })
+}
+
+fn solve_fem<const D: usize, E: ElementFamily<D>>(
+    scene: &Scene,
+    s: &SceneSettings,
+    mesh: impl Fn(SVector<f64, D>, SVector<f64, D>, [usize; D]) -> Result<ElementMesh<D, E>, InputError>,
+) -> Result<SceneOutcome, InputError> {
+    let [body] = &scene.bodies[..] else {
+        return Err(InputError::new(
+            "bodies",
+            format!("{} bodies", scene.bodies.len()),
+            "must be one box for the FEM methods (meshes of several bodies are not joined)",
+        ));
+    };
+    let h = s.element_size;
+    let mut n = [0; D];
+    for a in 0..D {
+        n[a] = cells(
+            &format!("bodies[0].box (axis {a})"),
+            body.bounds.max[a] - body.bounds.min[a],
+            h,
+        )?;
+    }
+    let lo = SVector::<f64, D>::from_iterator(body.bounds.min.iter().copied());
+    let hi = SVector::<f64, D>::from_iterator(body.bounds.max.iter().copied());
+    let mesh = mesh(lo, hi - lo, n)?;
+    let named = region_dofs(scene, h, &|f| {
+        for (k, x) in mesh.nodes.iter().enumerate() {
+            f(k, x.as_slice())
+        }
+    })?;
+    let (g, tabled) = gravity::<D>(scene);
+    let fixed: Vec<(usize, usize)> = named
+        .iter()
+        .filter(|n| n.2.is_none())
+        .flat_map(|n| n.1.iter().copied())
+        .collect();
+    let settings = PlaneFemSettings {
+        gauss_points: None,
+        newton: s.newton,
+        load_steps: s.load_steps,
+        // LDLᵀ, as the built-in problems' FEM (their results equal to the bit), unless CG is asked for.
+        linear_solver: if s.linear_solver == LinearSolver::Iterative {
+            LinearSolver::Iterative
+        } else {
+            LinearSolver::Ldlt
+        },
+    };
+    let model = scene.materials[&body.material].build()?;
+    let loads = FemLoads {
+        gravity: g,
+        nodal_forces: vec![],
+    };
+    let mut fem = ContinuumFem::try_new(mesh, body.density, model, fixed, loads, settings)?;
+    if let Some(b) = tabled_body_force(scene, tabled) {
+        fem.set_body_force(b);
+    }
+    for (_, _, p) in &named {
+        if let Some((values, ramp)) = p {
+            fem.prescribe(values, ramp.clone())?;
+        }
+    }
+    let measure = |fem: &ContinuumFem<D, E>| {
+        let displacement = |at: &[f64], axis: usize, _edge: bool| {
+            let node = fem
+                .mesh0
+                .nearest_node(SVector::<f64, D>::from_iterator(at.iter().copied()));
+            fem.displacement(node)[axis]
+        };
+        let reaction = |dofs: &[(usize, usize)], axis: usize| {
+            dofs.iter()
+                .filter(|d| d.1 == axis)
+                .map(|&(n, a)| fem.reaction(n, a))
+                .sum()
+        };
+        let energy = |e: f64, nu: f64| {
+            (0..fem.gauss.len())
+                .map(|q| energy(&fem.gauss.state[q], fem.gauss.volume0[q], e, nu))
+                .sum()
+        };
+        read_measures(
+            scene,
+            &named,
+            &Probe {
+                displacement: &displacement,
+                reaction: &reaction,
+                energy: &energy,
+            },
+        )
+    };
+    let mut history = vec![];
+    let run = fem.run_observed(&mut |fem, _| history.push(measure(fem)));
+    let (steps, failure) = steps_and_failure(run);
+    let last = measure(&fem);
+    Ok(SceneOutcome {
+        steps,
+        failure,
+        measures: gather(scene, history, last),
+        size: fem.mesh.num_elements(),
+        points: vec![],
+    })
+}
+
+/// What a case needs of its resolution, checked without building it: h divides the grid's
+/// extent (material points) or the body (FEM); the bodies lie on the point lattice of spacing
+/// h / points per cell; every support and displacement load holds a node (of the grid, or of
+/// the body's mesh for FEM). Errors name the key.
+pub fn check_resolution(scene: &Scene, s: &SceneSettings, method: Method) -> Result<(), InputError> {
+    let h = s.element_size;
+    let d = scene.dimension;
+    let mp = method.uses_material_points();
+    let mut n = vec![0usize; d];
+    for a in 0..d {
+        n[a] = cells(&format!("grid.extent[{a}]"), scene.grid.extent[a], h)?;
+    }
+    for (i, b) in scene.bodies.iter().enumerate() {
+        let step = if mp { h / s.points_per_cell as f64 } else { h };
+        for a in 0..d {
+            let what = if mp {
+                "h / points per cell"
+            } else {
+                "h (the FEM mesh)"
+            };
+            cells(
+                &format!("bodies[{i}].box.min[{a}]"),
+                b.bounds.min[a] - scene.grid.origin[a] + step,
+                step,
+            )
+            .and_then(|_| {
+                cells(
+                    &format!("bodies[{i}].box.max[{a}]"),
+                    b.bounds.max[a] - b.bounds.min[a],
+                    step,
+                )
+            })
+            .map_err(|e| {
+                InputError::new(
+                    e.field,
+                    e.value,
+                    format!("must lie on the lattice of {what} = {step} from the grid's origin"),
+                )
+            })?;
+        }
+    }
+    // The grid's nodes (material points) or those of the one body's box (FEM, linear lattice).
+    let lattice = |f: &mut dyn FnMut(usize, &[f64])| {
+        let total: usize = n.iter().map(|c| c + 1).product();
+        let mut x = vec![0.0; d];
+        for k in 0..total {
+            let mut r = k;
+            for a in 0..d {
+                x[a] = scene.grid.origin[a] + (r % (n[a] + 1)) as f64 * h;
+                r /= n[a] + 1;
+            }
+            if mp || scene.bodies[0].bounds.contains(&x, 1e-9 * h) {
+                f(k, &x);
+            }
+        }
+    };
+    region_dofs(scene, h, &lattice).map(|_| ())
+}

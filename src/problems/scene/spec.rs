@@ -1,0 +1,456 @@
+//! A scene as data: the grid, the bodies and their materials, the supports, the loads and the
+//! measures, in any dimension (2 or 3), with the checks that name the key of every bad value
+//! (`bodies[1].box.max[0]`). The study file's `problem = "scene"` sections deserialise into
+//! these types (`studies/README.md`, "Scenes").
+
+use crate::material::constitutive::Material;
+use crate::solver::error::{shortest, InputError};
+use crate::solver::ramp::Ramp;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// The axis names of a scene, in order.
+pub const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// The background grid: its lower corner and its extent along each axis. The element size h
+/// of a case divides every extent.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridSection {
+    pub origin: Vec<f64>,
+    pub extent: Vec<f64>,
+}
+
+/// An axis-aligned box `[min, max]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bounds {
+    pub min: Vec<f64>,
+    pub max: Vec<f64>,
+}
+
+/// The plane `axis = at`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Plane {
+    /// `x`, `y` or `z`.
+    pub axis: String,
+    pub at: f64,
+}
+
+/// A body: a box of material filled with points (or meshed, for FEM).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    pub name: String,
+    /// The body's box; its sides are whole multiples of h / points per cell.
+    #[serde(rename = "box")]
+    pub bounds: Bounds,
+    /// The name of a `[materials.<name>]` table.
+    pub material: String,
+    /// Mass per unit initial volume (default 1).
+    #[serde(default = "one")]
+    pub density: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// Grid (or mesh) nodes on a plane or in a box with some of their components fixed at zero.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Support {
+    pub name: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plane: Option<Plane>,
+    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
+    pub bounds: Option<Bounds>,
+    /// The fixed components: `["x"]` a roller, `["x", "y"]` full fixity in 2D.
+    pub fix: Vec<String>,
+}
+
+/// What a load is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LoadKind {
+    /// A body force per unit mass, `vector`, on every body.
+    Gravity,
+    /// A prescribed displacement of the nodes on a plane or in a box (`displacement`, the
+    /// components moved; the others stay free): a smooth platen moves one component, a rough
+    /// one all.
+    Displacement,
+}
+
+/// Prescribed displacement components (absent: free).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Components {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub x: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub y: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub z: Option<f64>,
+}
+
+impl Components {
+    /// (axis, value) of the given components.
+    pub fn given(&self) -> Vec<(usize, f64)> {
+        [self.x, self.y, self.z]
+            .iter()
+            .enumerate()
+            .filter_map(|(a, v)| v.map(|v| (a, v)))
+            .collect()
+    }
+}
+
+/// One load at the end of the analysis, reached over the load steps by its `ramp`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Load {
+    pub kind: LoadKind,
+    /// A displacement load's name (measures of reactions name it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Gravity: the acceleration vector.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vector: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plane: Option<Plane>,
+    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
+    pub bounds: Option<Bounds>,
+    /// Displacement: the prescribed components at full load.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub displacement: Option<Components>,
+    /// `"linear"` (default) or `{ table = [[0.0, 0.0], …, [1.0, f]] }`.
+    #[serde(default, skip_serializing_if = "is_linear")]
+    pub ramp: Ramp,
+}
+
+fn is_linear(r: &Ramp) -> bool {
+    *r == Ramp::Linear
+}
+
+/// What a measure reads from a case.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MeasureKind {
+    /// A displacement component of the material point whose initial position is nearest to
+    /// `at` (FEM: of the mesh node nearest to it); with `domain_edge`, of the point's domain
+    /// edge facing `at` (its displacement plus its half-length's growth).
+    Displacement,
+    /// The sum of one reaction component over a support's or a displacement load's nodes: the
+    /// force they exert on the body.
+    Reaction,
+    /// Σ V₀ W(εᵉ) over the points, W = μ εᵉ:εᵉ + λ/2 (tr εᵉ)² (Hencky; needs the material's
+    /// `young_modulus` and `poisson_ratio`).
+    StrainEnergy,
+}
+
+/// A closed form a measure is compared with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ClosedForm {
+    /// The smooth-platen force (reference/README.md item 65): τ_yy A₀ / λ along the platen's
+    /// axis, λ = 1 + δ / H.
+    PlatenForce,
+    /// The smooth-platen displacement (λ_i − 1)(at_i − min_i) of component i at `at`.
+    PlatenDisplacement,
+}
+
+/// The exact value a measure is compared with.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Reference {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub value: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub closed_form: Option<ClosedForm>,
+    /// A closed form's body (its box and material) and displacement load (its platen).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load: Option<String>,
+    /// Where the value or formula comes from.
+    pub source: String,
+}
+
+/// One named output of every case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Measure {
+    pub name: String,
+    pub kind: MeasureKind,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub at: Option<Vec<f64>>,
+    /// `x`, `y` or `z` (displacement and reaction).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub component: Option<String>,
+    /// A reaction's support or displacement load, by name.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<String>,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub domain_edge: bool,
+    /// Also record the value after every load step.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub history: bool,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<Reference>,
+}
+
+/// A whole scene with its materials resolved.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Scene {
+    pub dimension: usize,
+    pub grid: GridSection,
+    pub bodies: Vec<Body>,
+    pub materials: BTreeMap<String, Material>,
+    pub supports: Vec<Support>,
+    pub loads: Vec<Load>,
+    pub measures: Vec<Measure>,
+}
+
+pub(super) fn err(key: impl Into<String>, value: impl ToString, allowed: impl Into<String>) -> InputError {
+    InputError::new(key, value, allowed)
+}
+
+/// The index of axis name `name` below `dimension`.
+pub fn axis_index(key: &str, name: &str, dimension: usize) -> Result<usize, InputError> {
+    AXES[..dimension].iter().position(|a| *a == name).ok_or_else(|| {
+        err(
+            key,
+            format!("{name:?}"),
+            format!("must be one of {}", AXES[..dimension].join(", ")),
+        )
+    })
+}
+
+/// A vector of `dimension` finite values.
+pub(super) fn vector(key: &str, v: &[f64], dimension: usize) -> Result<(), InputError> {
+    if v.len() != dimension {
+        return Err(err(
+            key,
+            format!("{v:?}"),
+            format!("must have {dimension} values (dimension = {dimension})"),
+        ));
+    }
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(err(format!("{key}[{i}]"), v[i], "must be finite")),
+        None => Ok(()),
+    }
+}
+
+impl Bounds {
+    /// `dimension` finite values each, max above min (`strict`, a body) or not below it (a
+    /// region of nodes may be flat: a line or a plane of nodes).
+    fn check(&self, key: &str, dimension: usize, strict: bool) -> Result<(), InputError> {
+        vector(&format!("{key}.min"), &self.min, dimension)?;
+        vector(&format!("{key}.max"), &self.max, dimension)?;
+        for a in 0..dimension {
+            if self.max[a] < self.min[a] || strict && self.max[a] == self.min[a] {
+                return Err(err(
+                    format!("{key}.max[{a}]"),
+                    shortest(self.max[a]),
+                    format!(
+                        "must be {} {key}.min[{a}] = {}",
+                        if strict { "greater than" } else { "at least" },
+                        shortest(self.min[a])
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Does the box contain `x` (within `tol`)?
+    pub fn contains(&self, x: &[f64], tol: f64) -> bool {
+        x.iter()
+            .enumerate()
+            .all(|(a, &v)| v >= self.min[a] - tol && v <= self.max[a] + tol)
+    }
+}
+
+/// A node region: a plane or a box, exactly one of them.
+#[derive(Debug, Clone, Copy)]
+pub enum Region<'a> {
+    Plane(usize, f64),
+    Box(&'a Bounds),
+}
+
+impl Region<'_> {
+    /// Does the region hold the node at `x` (within `tol`)?
+    pub fn holds(&self, x: &[f64], tol: f64) -> bool {
+        match self {
+            Region::Plane(a, at) => (x[*a] - at).abs() <= tol,
+            Region::Box(b) => b.contains(x, tol),
+        }
+    }
+}
+
+/// The region of a support or load at `key` from its `plane` and `box` keys.
+pub fn region<'a>(
+    key: &str,
+    plane: &Option<Plane>,
+    bounds: &'a Option<Bounds>,
+    dimension: usize,
+) -> Result<Region<'a>, InputError> {
+    match (plane, bounds) {
+        (Some(p), None) => {
+            let a = axis_index(&format!("{key}.plane.axis"), &p.axis, dimension)?;
+            if !p.at.is_finite() {
+                return Err(err(format!("{key}.plane.at"), p.at, "must be finite"));
+            }
+            Ok(Region::Plane(a, p.at))
+        }
+        (None, Some(b)) => {
+            b.check(&format!("{key}.box"), dimension, false)?;
+            Ok(Region::Box(b))
+        }
+        (Some(_), Some(_)) => Err(err(key, "plane and box", "must give a plane or a box, not both")),
+        (None, None) => Err(err(
+            key,
+            "no region",
+            "must give a plane = { axis, at } or a box = { min, max }",
+        )),
+    }
+}
+
+impl Scene {
+    /// Check every value; an error names its key (`bodies[0].box.max[1]`), its value and the
+    /// allowed range. What depends on the element size (a region on no node, a body off the
+    /// point lattice) is checked when a case is built.
+    pub fn validate(&self) -> Result<(), InputError> {
+        let d = self.dimension;
+        if !matches!(d, 2 | 3) {
+            return Err(err("dimension", d, "must be 2 or 3"));
+        }
+        vector("grid.origin", &self.grid.origin, d)?;
+        vector("grid.extent", &self.grid.extent, d)?;
+        if let Some(a) = (0..d).find(|&a| self.grid.extent[a] <= 0.0) {
+            return Err(err(
+                format!("grid.extent[{a}]"),
+                self.grid.extent[a],
+                "must be > 0",
+            ));
+        }
+        let grid = Bounds {
+            min: self.grid.origin.clone(),
+            max: (0..d)
+                .map(|a| self.grid.origin[a] + self.grid.extent[a])
+                .collect(),
+        };
+        if self.bodies.is_empty() {
+            return Err(err("bodies", "[]", "must list at least one body ([[bodies]])"));
+        }
+        let mut names = std::collections::BTreeSet::new();
+        for (i, b) in self.bodies.iter().enumerate() {
+            let key = format!("bodies[{i}]");
+            self.name(&format!("{key}.name"), &b.name, &mut names)?;
+            b.bounds.check(&format!("{key}.box"), d, true)?;
+            if !(b.bounds.contains(&grid.min, f64::INFINITY)
+                && grid.contains(&b.bounds.min, 1e-12)
+                && grid.contains(&b.bounds.max, 1e-12))
+            {
+                return Err(err(
+                    format!("{key}.box"),
+                    format!("{:?} .. {:?}", b.bounds.min, b.bounds.max),
+                    format!("must lie inside the grid {:?} .. {:?}", grid.min, grid.max),
+                ));
+            }
+            if !(b.density.is_finite() && b.density > 0.0) {
+                return Err(err(format!("{key}.density"), b.density, "must be finite and > 0"));
+            }
+            if !self.materials.contains_key(&b.material) {
+                let known: Vec<&str> = self.materials.keys().map(String::as_str).collect();
+                return Err(err(
+                    format!("{key}.material"),
+                    format!("{:?}", b.material),
+                    format!("must name a [materials.<name>] table: {}", known.join(", ")),
+                ));
+            }
+            if b.material != self.bodies[0].material {
+                return Err(err(
+                    format!("{key}.material"),
+                    format!("{:?}", b.material),
+                    format!(
+                        "must be bodies[0]'s {:?}: the solvers hold one constitutive model for all points",
+                        self.bodies[0].material
+                    ),
+                ));
+            }
+            for (j, o) in self.bodies[..i].iter().enumerate() {
+                let overlap =
+                    (0..d).all(|a| b.bounds.min[a] < o.bounds.max[a] && o.bounds.min[a] < b.bounds.max[a]);
+                if overlap {
+                    return Err(err(
+                        format!("{key}.box"),
+                        format!("{:?} .. {:?}", b.bounds.min, b.bounds.max),
+                        format!("must not overlap bodies[{j}] ({:?})", o.name),
+                    ));
+                }
+            }
+        }
+        for (i, s) in self.supports.iter().enumerate() {
+            let key = format!("supports[{i}]");
+            self.name(&format!("{key}.name"), &s.name, &mut names)?;
+            region(&key, &s.plane, &s.bounds, d)?;
+            self.components(&format!("{key}.fix"), &s.fix)?;
+        }
+        if self.loads.is_empty() {
+            return Err(err("loads", "[]", "must list at least one load ([[loads]])"));
+        }
+        for (i, l) in self.loads.iter().enumerate() {
+            self.check_load(i, l, &mut names)?;
+        }
+        let mut measures = std::collections::BTreeSet::new();
+        for (i, m) in self.measures.iter().enumerate() {
+            self.check_measure(i, m, &mut measures)?;
+        }
+        Ok(())
+    }
+
+    /// A non-empty name not used before (bodies, supports and loads share one namespace).
+    pub(super) fn name(
+        &self,
+        key: &str,
+        name: &str,
+        names: &mut std::collections::BTreeSet<String>,
+    ) -> Result<(), InputError> {
+        if name.trim().is_empty() || name.len() > 64 {
+            return Err(err(
+                key,
+                format!("{name:?}"),
+                "must be a name of 1 to 64 characters",
+            ));
+        }
+        if !names.insert(name.to_string()) {
+            return Err(err(
+                key,
+                format!("{name:?}"),
+                "must differ from every other body's, support's and load's name",
+            ));
+        }
+        Ok(())
+    }
+
+    /// At least one component name, each once.
+    pub(super) fn components(&self, key: &str, names: &[String]) -> Result<Vec<usize>, InputError> {
+        if names.is_empty() {
+            return Err(err(key, "[]", "must list the fixed components, e.g. [\"x\"]"));
+        }
+        let mut axes = vec![];
+        for (j, n) in names.iter().enumerate() {
+            let a = axis_index(&format!("{key}[{j}]"), n, self.dimension)?;
+            if axes.contains(&a) {
+                return Err(err(
+                    format!("{key}[{j}]"),
+                    format!("{n:?}"),
+                    "must not repeat a component",
+                ));
+            }
+            axes.push(a);
+        }
+        Ok(axes)
+    }
+}

@@ -1,0 +1,231 @@
+//! The checks of a scene's loads and measures (the rest of [`Scene::validate`]).
+
+use super::spec::{
+    axis_index, err, region, vector, ClosedForm, Load, LoadKind, Measure, MeasureKind, Reference, Scene, AXES,
+};
+use crate::solver::error::InputError;
+use std::collections::BTreeSet;
+
+impl Scene {
+    pub(super) fn check_load(
+        &self,
+        i: usize,
+        l: &Load,
+        names: &mut BTreeSet<String>,
+    ) -> Result<(), InputError> {
+        let key = format!("loads[{i}]");
+        let d = self.dimension;
+        l.ramp.validate(&format!("{key}.ramp"))?;
+        let refuse = |field: &str, given: bool| -> Result<(), InputError> {
+            if given {
+                return Err(err(
+                    format!("{key}.{field}"),
+                    "given",
+                    format!(
+                        "is not a key of a {} load",
+                        if l.kind == LoadKind::Gravity {
+                            "gravity"
+                        } else {
+                            "displacement"
+                        }
+                    ),
+                ));
+            }
+            Ok(())
+        };
+        match l.kind {
+            LoadKind::Gravity => {
+                refuse("name", l.name.is_some())?;
+                refuse("plane", l.plane.is_some())?;
+                refuse("box", l.bounds.is_some())?;
+                refuse("displacement", l.displacement.is_some())?;
+                let v = l.vector.as_ref().ok_or_else(|| {
+                    err(
+                        format!("{key}.vector"),
+                        "missing",
+                        "a gravity load needs its vector",
+                    )
+                })?;
+                vector(&format!("{key}.vector"), v, d)
+            }
+            LoadKind::Displacement => {
+                refuse("vector", l.vector.is_some())?;
+                let name = l.name.as_ref().ok_or_else(|| {
+                    err(
+                        format!("{key}.name"),
+                        "missing",
+                        "a displacement load needs a name",
+                    )
+                })?;
+                self.name(&format!("{key}.name"), name, names)?;
+                region(&key, &l.plane, &l.bounds, d)?;
+                let c = l.displacement.as_ref().ok_or_else(|| {
+                    err(
+                        format!("{key}.displacement"),
+                        "missing",
+                        "must give the moved components, e.g. { y = -0.1 }",
+                    )
+                })?;
+                let given = c.given();
+                if given.is_empty() {
+                    return Err(err(
+                        format!("{key}.displacement"),
+                        "{}",
+                        "must give at least one component",
+                    ));
+                }
+                for (a, v) in given {
+                    let k = format!("{key}.displacement.{}", AXES[a]);
+                    if a >= d {
+                        return Err(err(k, v, format!("is not a component in dimension {d}")));
+                    }
+                    if !v.is_finite() {
+                        return Err(err(k, v, "must be finite"));
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
+    pub(super) fn check_measure(
+        &self,
+        i: usize,
+        m: &Measure,
+        names: &mut BTreeSet<String>,
+    ) -> Result<(), InputError> {
+        let key = format!("measures[{i}]");
+        let d = self.dimension;
+        if m.name.trim().is_empty() || m.name.len() > 64 || !names.insert(m.name.clone()) {
+            return Err(err(
+                format!("{key}.name"),
+                format!("{:?}", m.name),
+                "must be a name of 1 to 64 characters, each measure's its own",
+            ));
+        }
+        let refuse = |field: &str, given: bool| -> Result<(), InputError> {
+            if given {
+                return Err(err(
+                    format!("{key}.{field}"),
+                    "given",
+                    format!("is not a key of a {:?} measure", m.kind),
+                ));
+            }
+            Ok(())
+        };
+        match m.kind {
+            MeasureKind::Displacement => {
+                refuse("region", m.region.is_some())?;
+                let at = m.at.as_ref().ok_or_else(|| {
+                    err(
+                        format!("{key}.at"),
+                        "missing",
+                        "a displacement measure needs its point",
+                    )
+                })?;
+                vector(&format!("{key}.at"), at, d)?;
+                self.component(&key, m)?;
+            }
+            MeasureKind::Reaction => {
+                refuse("at", m.at.is_some())?;
+                refuse("domain_edge", m.domain_edge)?;
+                let r = m.region.as_ref().ok_or_else(|| {
+                    err(
+                        format!("{key}.region"),
+                        "missing",
+                        "a reaction needs the name of a support or displacement load",
+                    )
+                })?;
+                let known = self.supports.iter().any(|s| &s.name == r)
+                    || self
+                        .loads
+                        .iter()
+                        .any(|l| l.kind == LoadKind::Displacement && l.name.as_ref() == Some(r));
+                if !known {
+                    return Err(err(
+                        format!("{key}.region"),
+                        format!("{r:?}"),
+                        "must name a support or a displacement load",
+                    ));
+                }
+                self.component(&key, m)?;
+            }
+            MeasureKind::StrainEnergy => {
+                for (f, g) in [
+                    ("at", m.at.is_some()),
+                    ("region", m.region.is_some()),
+                    ("component", m.component.is_some()),
+                    ("domain_edge", m.domain_edge),
+                ] {
+                    refuse(f, g)?;
+                }
+                self.hencky_parameters(&format!("{key}.kind"))?;
+            }
+        }
+        if let Some(r) = &m.reference {
+            self.check_reference(&format!("{key}.reference"), m, r)?;
+        }
+        Ok(())
+    }
+
+    fn component(&self, key: &str, m: &Measure) -> Result<usize, InputError> {
+        let c = m
+            .component
+            .as_ref()
+            .ok_or_else(|| err(format!("{key}.component"), "missing", "must be x, y or z"))?;
+        axis_index(&format!("{key}.component"), c, self.dimension)
+    }
+
+    /// (E, ν) of the bodies' material, which a Hencky energy or closed form needs.
+    pub fn hencky_parameters(&self, key: &str) -> Result<(f64, f64), InputError> {
+        let m = &self.materials[&self.bodies[0].material];
+        match (m.get("young_modulus"), m.get("poisson_ratio")) {
+            (Some(e), Some(nu)) => Ok((e, nu)),
+            _ => Err(err(
+                key,
+                m.model(),
+                "needs a material with young_modulus and poisson_ratio",
+            )),
+        }
+    }
+
+    fn check_reference(&self, key: &str, m: &Measure, r: &Reference) -> Result<(), InputError> {
+        if r.source.trim().is_empty() {
+            return Err(err(
+                format!("{key}.source"),
+                "\"\"",
+                "must say where the reference comes from",
+            ));
+        }
+        match (r.value, r.closed_form) {
+            (Some(v), None) => {
+                if !v.is_finite() {
+                    return Err(err(format!("{key}.value"), v, "must be finite"));
+                }
+                if r.body.is_some() || r.load.is_some() {
+                    return Err(err(key, "body/load", "a value needs no body or load"));
+                }
+                Ok(())
+            }
+            (None, Some(form)) => {
+                let wanted = match form {
+                    ClosedForm::PlatenForce => MeasureKind::Reaction,
+                    ClosedForm::PlatenDisplacement => MeasureKind::Displacement,
+                };
+                if m.kind != wanted {
+                    return Err(err(
+                        format!("{key}.closed_form"),
+                        format!("{form:?}"),
+                        format!("is a closed form of a {wanted:?} measure"),
+                    ));
+                }
+                self.platen(key, r).map(|_| ())
+            }
+            _ => Err(err(
+                key,
+                "value and closed_form",
+                "must give exactly one of value or closed_form",
+            )),
+        }
+    }
+}

@@ -1,0 +1,257 @@
+//! Rendering of a scene study from `results.json` alone: the report (every measure of every
+//! case beside its reference, the fitted rates, the checks) and, per sweep, a log-log figure of
+//! each referenced measure's error against h and a load curve of each history measure.
+
+use super::{checks_markdown, failures_markdown, IndexEntry};
+use crate::study::checks::check_counts;
+use crate::study::render::plot::{convergence_svg_along, ConvergenceSeries};
+use crate::study::render::plot2d::{xy_svg, LegendCorner, XyAxes, XySeries};
+use crate::study::results::{read_results, CaseStatus};
+use crate::study::scene::SceneResults;
+use crate::study::StudyError;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// (title, id) of every figure the results can draw, in order.
+fn figures(r: &SceneResults) -> Vec<(String, String, Figure)> {
+    let mut out = vec![];
+    for s in &r.study.sweeps {
+        for m in &r.study.measures {
+            if r.measures.references.contains_key(&m.name) {
+                out.push((
+                    format!("{}: error of {} against h", s.title, m.name),
+                    format!("{}-{}-error", s.id, m.name),
+                    Figure::Error(s.id.clone(), m.name.clone()),
+                ));
+            }
+            if m.history {
+                out.push((
+                    format!("{}: {} over the load steps", s.title, m.name),
+                    format!("{}-{}-history", s.id, m.name),
+                    Figure::History(s.id.clone(), m.name.clone()),
+                ));
+            }
+        }
+    }
+    out
+}
+
+enum Figure {
+    Error(String, String),
+    History(String, String),
+}
+
+fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, String> {
+    match f {
+        Figure::Error(sweep, measure) => {
+            let series: Vec<ConvergenceSeries> = r
+                .measures
+                .rates
+                .iter()
+                .filter(|x| &x.sweep == sweep && &x.measure == measure && x.errors.len() >= 2)
+                .map(|x| ConvergenceSeries {
+                    label: match x.points_per_cell {
+                        Some(p) => format!("{} {p}ppc", x.method.name()),
+                        None => x.method.name().to_string(),
+                    },
+                    // Exact answers (round-off) plot at the floor of the axis, not at 0.
+                    points: x.errors.iter().map(|&(h, e)| (1.0 / h, e.max(1e-17))).collect(),
+                    slope: x.slope,
+                })
+                .collect();
+            if series.is_empty() {
+                return Ok(None);
+            }
+            convergence_svg_along(title, "1 / h", "relative error", &series, true).map(Some)
+        }
+        Figure::History(sweep, measure) => {
+            let mut series = vec![];
+            for c in r.sweep(sweep) {
+                let Some(h) = c.histories.get(measure) else {
+                    continue;
+                };
+                let n = h.len() as f64;
+                series.push(XySeries {
+                    label: c.id.clone(),
+                    points: h
+                        .iter()
+                        .enumerate()
+                        .map(|(k, &v)| ((k + 1) as f64 / n, v))
+                        .collect(),
+                    line: true,
+                    markers: true,
+                });
+            }
+            if let Some(reference) = r
+                .measures
+                .references
+                .get(measure)
+                .filter(|x| !x.history.is_empty())
+            {
+                let n = reference.history.len() as f64;
+                series.push(XySeries {
+                    label: "reference".into(),
+                    points: reference
+                        .history
+                        .iter()
+                        .enumerate()
+                        .map(|(k, &v)| ((k + 1) as f64 / n, v))
+                        .collect(),
+                    line: true,
+                    markers: false,
+                });
+            }
+            if series.is_empty() {
+                return Ok(None);
+            }
+            let axes = XyAxes {
+                x_desc: "load fraction".into(),
+                y_desc: measure.clone(),
+                log_x: false,
+                log_y: false,
+                y_lines: vec![],
+                legend: LegendCorner::LowerLeft,
+            };
+            xy_svg(title, &axes, &series).map(Some)
+        }
+    }
+}
+
+fn e3(x: Option<f64>) -> String {
+    x.map_or("—".into(), |v| format!("{v:.3e}"))
+}
+
+pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> String {
+    let study = &r.study;
+    let (pass, fail, none) = check_counts(&r.checks);
+    let mut s = format!(
+        "# {}: {}\n\n{}\n\nChecks: {pass} passed, {fail} failed, {none} not evaluated.\n\n",
+        super::md_text(&study.name),
+        super::md_text(&study.summary),
+        r.provenance.line()
+    );
+    let _ = writeln!(
+        s,
+        "A scene in {}D: {} bod{} ({}), {} support(s), {} load(s), {} load steps. Errors are relative to the reference's magnitude.\n",
+        study.dimension,
+        study.bodies.len(),
+        if study.bodies.len() == 1 { "y" } else { "ies" },
+        study.bodies.iter().map(|b| format!("{} of {}", b.name, b.material)).collect::<Vec<_>>().join(", "),
+        study.supports.len(),
+        study.loads.len(),
+        study.load_steps
+    );
+    s.push_str("## References\n\n| measure | value | source |\n|---|---:|---|\n");
+    for (name, v) in &r.measures.references {
+        let _ = writeln!(s, "| {name} | {:.10e} | {} |", v.value, super::md_text(&v.source));
+    }
+    s.push('\n');
+    for sw in &study.sweeps {
+        let cases = r.sweep(&sw.id);
+        if cases.is_empty() {
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            "## {}\n\n{}\n",
+            super::md_text(&sw.id),
+            super::md_text(&sw.title)
+        );
+        s.push_str("| case | status | Newton |");
+        for m in &study.measures {
+            let _ = write!(s, " {} |", m.name);
+            if r.measures.references.contains_key(&m.name) {
+                let _ = write!(s, " error |");
+            }
+        }
+        s.push_str("\n|---|---|---:|");
+        for m in &study.measures {
+            s.push_str("---:|");
+            if r.measures.references.contains_key(&m.name) {
+                s.push_str("---:|");
+            }
+        }
+        s.push('\n');
+        for c in cases {
+            let _ = write!(
+                s,
+                "| {} | {} | {} |",
+                c.id,
+                c.solve.status.word(),
+                c.solve.newton_iterations
+            );
+            for m in &study.measures {
+                let v = c.measures.get(&m.name).copied();
+                let _ = write!(s, " {} |", v.map_or("—".into(), |v| format!("{v:.6e}")));
+                if let Some(reference) = r.measures.references.get(&m.name) {
+                    let e = v
+                        .filter(|_| c.solve.status == CaseStatus::Converged)
+                        .map(|v| (v - reference.value).abs() / reference.value.abs().max(f64::MIN_POSITIVE));
+                    let _ = write!(s, " {} |", e3(e));
+                }
+            }
+            s.push('\n');
+        }
+        s.push('\n');
+    }
+    let fitted: Vec<_> = r.measures.rates.iter().filter(|x| x.slope.is_some()).collect();
+    if !fitted.is_empty() {
+        s.push_str("## Fitted rates\n\nSlope of log(error) against log(h) over every converged h of the series.\n\n| sweep | measure | series | slope |\n|---|---|---|---:|\n");
+        for x in fitted {
+            let ppc = x.points_per_cell.map_or(String::new(), |p| format!(" {p}ppc"));
+            let _ = writeln!(
+                s,
+                "| {} | {} | {}{ppc} | {:.2} |",
+                x.sweep,
+                x.measure,
+                x.method.name(),
+                x.slope.unwrap_or(f64::NAN)
+            );
+        }
+        s.push('\n');
+    }
+    s.push_str(&checks_markdown(&r.checks));
+    s.push_str(&super::performance_markdown(&r.cases, &r.timing));
+    s.push_str(&failures_markdown(
+        r.cases
+            .iter()
+            .map(|c| (c.id.as_str(), c.solve.status, c.solve.failure.as_ref())),
+    ));
+    let figs = figures(r);
+    s.push_str(&super::figures_markdown(
+        figs.iter().map(|(t, id, _)| (t.as_str(), id.as_str())),
+        not_drawn,
+    ));
+    s
+}
+
+/// Render the report and figures from `dir`'s `results.json`.
+pub fn render(dir: &Path) -> Result<super::Rendered, StudyError> {
+    let results: SceneResults = read_results(dir)?;
+    let mut files = super::Files::new(dir);
+    for (title, id, f) in figures(&results) {
+        let svg =
+            draw(&results, &title, &f).map_err(|e| StudyError::io(&dir.join(format!("{id}.svg")), e))?;
+        files.figure(
+            &id,
+            svg,
+            "no data (fewer than two converged cases, or no history)",
+        )?;
+    }
+    let report = report_markdown(&results, &files.not_drawn);
+    files.report(&results.study.report_file, &report)?;
+    Ok(files.done())
+}
+
+pub fn index_entry(dir: &Path) -> Result<IndexEntry, StudyError> {
+    let r: SceneResults = read_results(dir)?;
+    let figs: Vec<(String, String)> = figures(&r).into_iter().map(|(t, id, _)| (t, id)).collect();
+    Ok(super::plane_index_entry(
+        (&r.study.name, &r.study.summary, r.provenance.tier),
+        ("every case's measures", "results.json"),
+        &r.checks,
+        &r.study.report_file,
+        std::iter::empty(),
+        super::drawn(dir, figs),
+    ))
+}

@@ -1,0 +1,287 @@
+//! The scene as a study kind: one case is the scene solved by one method at one resolution
+//! ([`crate::problems::scene::solve`]); its record carries every measure (and the histories
+//! asked for); the kind adds each measure's reference, the fitted rates of the errors and the
+//! checks.
+
+use super::{RateRecord, ReferenceValue, SceneCase, SceneMeasures, SceneRecord, SceneResults, SceneStudy};
+use crate::problems::scene::{solve, ClosedForm, Scene};
+use crate::study::checks::{check_at_most, check_rate, CheckRecord};
+use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
+use crate::study::results::{CaseStatus, SolveRecord, SweepIndex};
+use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
+use crate::study::{StudyError, Tier};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+fn solve_case(scene: &Scene, case: &SceneCase) -> (SceneRecord, Vec<crate::problems::scene::PointRecord>) {
+    let (solve, o) = match solve(scene, &case.settings, case.method) {
+        Err(e) => (SolveRecord::rejected(e), None),
+        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
+    };
+    let mut measures = BTreeMap::new();
+    let mut histories = BTreeMap::new();
+    if let Some(o) = &o {
+        for m in &o.measures {
+            if m.value.is_finite() && !o.steps.is_empty() {
+                measures.insert(m.name.clone(), m.value);
+            }
+            if !m.history.is_empty() {
+                histories.insert(m.name.clone(), m.history.clone());
+            }
+        }
+    }
+    let rec = SceneRecord {
+        id: case.id.clone(),
+        method: case.method,
+        h: case.settings.element_size,
+        points_per_cell: case
+            .method
+            .uses_material_points()
+            .then_some(case.settings.points_per_cell),
+        solve,
+        measures,
+        histories,
+        points: o.as_ref().map_or(0, |o| o.size),
+    };
+    (rec, o.map_or(vec![], |o| o.points))
+}
+
+impl StudyKind for SceneStudy {
+    const PROBLEM: &'static str = "scene";
+    type Case = SceneCase;
+    type Output = SceneRecord;
+    type Record = SceneRecord;
+    type Measures = SceneMeasures;
+
+    study_file_fields!();
+    fn cases(&self, tier: Tier) -> (Vec<SceneCase>, SweepIndex) {
+        self.cases(tier)
+    }
+    fn key(&self, c: &SceneCase) -> CaseKey {
+        // The scene is part of every case's definition: editing it re-solves the cases.
+        CaseKey::of_spec(&c.id, c.method, &(&self.scene(), &c.settings), 0)
+    }
+    fn cost(&self, c: &SceneCase) -> f64 {
+        let s = &c.settings;
+        (s.points_per_cell as f64 / s.element_size).powi(self.dimension as i32) * s.load_steps as f64
+    }
+    fn solve(&self, c: &SceneCase, vtk: Option<&VtkTarget>) -> Result<SceneRecord, StudyError> {
+        let (rec, points) = solve_case(&self.scene(), c);
+        if let (Some(v), false) = (vtk, points.is_empty()) {
+            let d = self.dimension as usize;
+            let boxes = |initial: bool| -> Vec<DomainBox> {
+                points
+                    .iter()
+                    .map(|p| {
+                        let (x, h) = if initial { (p.x0, p.half0) } else { (p.x, p.half) };
+                        if d == 3 {
+                            DomainBox::new(x, h)
+                        } else {
+                            DomainBox::new([x[0], x[1]], [h[0], h[1]])
+                        }
+                    })
+                    .collect()
+            };
+            let stress = if d == 3 { "sigma_zz" } else { "sigma_yy" };
+            let frames = [
+                DomainFrame {
+                    time: 0.0,
+                    step: 0,
+                    dimension: d,
+                    domains: boxes(true),
+                    scalars: vec![],
+                },
+                DomainFrame {
+                    time: 1.0,
+                    step: rec.solve.steps.len(),
+                    dimension: d,
+                    domains: boxes(false),
+                    scalars: vec![(stress.to_string(), points.iter().map(|p| p.sigma).collect())],
+                },
+            ];
+            write_domain_frames(&v.study_dir, &c.id, &frames, None)?;
+        }
+        Ok(rec)
+    }
+    fn record(o: &SceneRecord) -> &SceneRecord {
+        o
+    }
+    fn measure(results: &mut Results<Self>) {
+        results.measures = measures(results);
+        results.checks = checks(results);
+    }
+    fn write_side_files(&self, _dir: &Path, _outputs: &[SceneRecord]) -> Result<(), StudyError> {
+        Ok(())
+    }
+}
+
+/// A series of a sweep: the method's name and the points per cell.
+type Series = (String, Option<usize>);
+
+/// Each measure's reference, and the fitted rates of the errors.
+fn measures(results: &SceneResults) -> SceneMeasures {
+    let study = &results.study;
+    let scene = study.scene();
+    let steps = study.load_steps.max(1) as usize;
+    let mut references = BTreeMap::new();
+    for m in &scene.measures {
+        let Some(r) = &m.reference else { continue };
+        let at = |t: f64| -> Option<f64> {
+            match r.closed_form {
+                None => r.value,
+                Some(form) => {
+                    let p = scene.platen("", r).ok()?;
+                    let axis = m
+                        .component
+                        .as_ref()
+                        .and_then(|c| crate::problems::scene::axis_index("", c, scene.dimension).ok())?;
+                    Some(match form {
+                        ClosedForm::PlatenForce => p.force(t),
+                        ClosedForm::PlatenDisplacement => p.displacement(m.at.as_deref()?, axis, t),
+                    })
+                }
+            }
+        };
+        let Some(value) = at(1.0) else { continue };
+        let history = if m.history && r.closed_form.is_some() {
+            (1..=steps).filter_map(|k| at(k as f64 / steps as f64)).collect()
+        } else {
+            vec![]
+        };
+        references.insert(
+            m.name.clone(),
+            ReferenceValue {
+                value,
+                history,
+                source: r.source.clone(),
+            },
+        );
+    }
+    let mut rates = vec![];
+    for s in &study.sweeps {
+        let cases = results.sweep(&s.id);
+        for (name, r) in &references {
+            let mut series: BTreeMap<Series, Vec<(f64, f64)>> = BTreeMap::new();
+            for c in cases.iter().filter(|c| c.solve.status == CaseStatus::Converged) {
+                if let Some(v) = c.measures.get(name) {
+                    let e = (v - r.value).abs() / r.value.abs().max(f64::MIN_POSITIVE);
+                    series
+                        .entry((c.method.name().to_string(), c.points_per_cell))
+                        .or_default()
+                        .push((c.h, e));
+                }
+            }
+            for ((method, ppc), mut errors) in series {
+                errors.sort_by(|a, b| b.0.total_cmp(&a.0));
+                let (h, e): (Vec<f64>, Vec<f64>) = errors.iter().copied().unzip();
+                let slope = (errors.len() >= 2)
+                    .then(|| crate::problems::norms::fitted_rate(&h, &e))
+                    .flatten();
+                let method = cases
+                    .iter()
+                    .find(|c| c.method.name() == method)
+                    .map(|c| c.method)
+                    .expect("a case of the series");
+                rates.push(RateRecord {
+                    sweep: s.id.clone(),
+                    measure: name.clone(),
+                    method,
+                    points_per_cell: ppc,
+                    errors,
+                    slope,
+                });
+            }
+        }
+    }
+    SceneMeasures { references, rates }
+}
+
+/// The largest relative error of `case`'s measure `name` against `r`, at the end and after
+/// every step of a history (whose steps are the study's load steps).
+fn largest_error(case: &SceneRecord, name: &str, r: &ReferenceValue) -> Option<f64> {
+    let scale = r.value.abs().max(f64::MIN_POSITIVE);
+    let mut worst = (case.measures.get(name)? - r.value).abs() / scale;
+    if let Some(h) = case.histories.get(name) {
+        if h.len() == r.history.len() {
+            for (v, e) in h.iter().zip(&r.history) {
+                worst = worst.max((v - e).abs() / scale);
+            }
+        }
+    }
+    Some(worst)
+}
+
+fn checks(results: &SceneResults) -> Vec<CheckRecord> {
+    let study = &results.study;
+    let mut out = vec![];
+    for e in &study.expect_reference {
+        let r = results.measures.references.get(&e.measure);
+        let cases: Vec<&SceneRecord> = results
+            .sweep(&e.sweep)
+            .into_iter()
+            .filter(|c| e.methods.is_empty() || e.methods.contains(&c.method))
+            .collect();
+        if cases.is_empty() {
+            // The tier does not run the sweep (a full-tier sweep in the quick tier).
+            continue;
+        }
+        let failed = cases.iter().any(|c| c.solve.status != CaseStatus::Converged);
+        let worst = r.and_then(|r| {
+            let errors: Option<Vec<f64>> = cases.iter().map(|c| largest_error(c, &e.measure, r)).collect();
+            errors
+                .filter(|v| !v.is_empty() && !failed)
+                .map(|v| v.into_iter().fold(0.0, f64::max))
+        });
+        let who = if e.methods.is_empty() {
+            "every method".to_string()
+        } else {
+            e.methods.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")
+        };
+        out.push(check_at_most(
+            &format!("{}-{}-reference", e.sweep, e.measure),
+            format!(
+                "{} of {who} in sweep {} within {:e} of its reference (measured: the largest relative error over {} cases{})",
+                e.measure,
+                e.sweep,
+                e.tolerance,
+                cases.len(),
+                if failed { "; a case did not converge" } else { "" }
+            ),
+            worst,
+            e.tolerance,
+            &e.source,
+        ));
+    }
+    for e in &study.expect_rate {
+        for r in results
+            .measures
+            .rates
+            .iter()
+            .filter(|r| r.sweep == e.sweep && r.measure == e.measure && r.method == e.method)
+        {
+            let ppc = r
+                .points_per_cell
+                .map_or(String::new(), |p| format!(", {p} points per cell"));
+            out.push(check_rate(
+                &format!(
+                    "{}-{}-{}-rate{}",
+                    e.sweep,
+                    e.measure,
+                    e.method.name(),
+                    r.points_per_cell.map_or(String::new(), |p| format!("-ppc{p}"))
+                ),
+                &format!(
+                    "error of {} by {}{ppc} in sweep {}",
+                    e.measure,
+                    e.method.name(),
+                    e.sweep
+                ),
+                r.slope,
+                e.rate,
+                e.tolerance,
+                &e.source,
+            ));
+        }
+    }
+    out
+}
