@@ -5,6 +5,7 @@
 //! carries the whole imposed motion and the reactions there are the internal force minus the
 //! external one ([`super::assembly::StepWorkspace::reaction`]).
 
+use crate::solver::error::InputError;
 use crate::solver::ramp::Ramp;
 
 /// Groups of prescribed dofs (dof = node·D + axis) with their values at full load.
@@ -19,6 +20,29 @@ impl PrescribedDisplacements {
     /// Prescribe `dofs` (dof, value at full load), following `ramp`.
     pub fn add(&mut self, dofs: Vec<(usize, f64)>, ramp: Ramp) {
         self.groups.push((dofs, ramp));
+    }
+
+    /// Prescribe `dofs` (node, axis, value at full load) of a `D`-dimensional discretisation
+    /// of `num_nodes` nodes after checking them and `ramp`: an error names the first bad one.
+    pub fn add_checked<const D: usize>(
+        &mut self,
+        dofs: &[(usize, usize, f64)],
+        num_nodes: usize,
+        ramp: Ramp,
+    ) -> Result<(), InputError> {
+        ramp.validate("ramp")?;
+        if let Some(&(n, a, v)) = dofs
+            .iter()
+            .find(|&&(n, a, v)| n >= num_nodes || a >= D || !v.is_finite())
+        {
+            return Err(InputError::new(
+                "prescribed dof",
+                format!("(node {n}, axis {a}, {v})"),
+                format!("node < {num_nodes}, axis < {D} and a finite value"),
+            ));
+        }
+        self.add(dofs.iter().map(|&(n, a, v)| (n * D + a, v)).collect(), ramp);
+        Ok(())
     }
 
     /// No dof is prescribed.

@@ -314,24 +314,13 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
         dofs: &[(usize, usize, f64)],
         ramp: crate::solver::ramp::Ramp,
     ) -> Result<(), InputError> {
-        ramp.validate("ramp")?;
-        let nn = self.mesh.num_nodes();
-        for &(n, a, v) in dofs {
-            if n >= nn || a >= D || !v.is_finite() {
-                return Err(InputError::new(
-                    "prescribed dof",
-                    format!("(node {n}, axis {a}, {v})"),
-                    format!("node < {nn}, axis < {D} and a finite value"),
-                ));
-            }
-        }
+        self.core
+            .prescribed
+            .add_checked::<D>(dofs, self.mesh.num_nodes(), ramp)?;
         for &(n, a, _) in dofs {
             self.fixed.push((n, a));
             self.core.fixed_dofs.push((n, a));
         }
-        self.core
-            .prescribed
-            .add(dofs.iter().map(|&(n, a, v)| (n * D + a, v)).collect(), ramp);
         Ok(())
     }
 

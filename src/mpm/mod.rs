@@ -180,20 +180,9 @@ impl<const D: usize> MpmSolver<D> {
         dofs: &[(usize, usize, f64)],
         ramp: crate::solver::ramp::Ramp,
     ) -> Result<(), InputError> {
-        ramp.validate("ramp")?;
-        let nn = self.grid.num_nodes();
-        for &(n, a, v) in dofs {
-            if n >= nn || a >= D || !v.is_finite() {
-                return Err(InputError::new(
-                    "prescribed dof",
-                    format!("(node {n}, axis {a}, {v})"),
-                    format!("node < {nn}, axis < {D} and a finite value"),
-                ));
-            }
-        }
-        self.fixed.extend(dofs.iter().map(|&(n, a, _)| (n, a)));
         self.prescribed
-            .add(dofs.iter().map(|&(n, a, v)| (n * D + a, v)).collect(), ramp);
+            .add_checked::<D>(dofs, self.grid.num_nodes(), ramp)?;
+        self.fixed.extend(dofs.iter().map(|&(n, a, _)| (n, a)));
         Ok(())
     }
 

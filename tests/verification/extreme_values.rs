@@ -16,6 +16,7 @@ use igimp::study::compaction::CompactionStudy;
 use igimp::study::dynamics::DynamicStudy;
 use igimp::study::engine::{self, StudyKind};
 use igimp::study::manufactured::ManufacturedStudy;
+use igimp::study::scene::SceneStudy;
 use igimp::study::results::CaseRecordOf;
 use igimp::study::{StudyError, Tier};
 use std::collections::BTreeSet;
@@ -264,6 +265,7 @@ fn probe_kind(problem: &str) {
             "cantilever" => probe::<CantileverStudy>(&name, &text, &mut tally),
             "manufactured" => probe::<ManufacturedStudy>(&name, &text, &mut tally),
             "dynamics" => probe::<DynamicStudy>(&name, &text, &mut tally),
+            "scene" => probe::<SceneStudy>(&name, &text, &mut tally),
             other => panic!("{name}: no probe for problem {other:?}"),
         }
         assert!(tally.rejected > 0 && tally.accepted > 0, "{name}: nothing probed");
@@ -309,6 +311,11 @@ fn extreme_values_in_dynamics_studies_are_rejected_or_solved_and_measured() {
     probe_kind("dynamics");
 }
 
+#[test]
+fn extreme_values_in_scene_studies_are_rejected_or_solved_and_measured() {
+    probe_kind("scene");
+}
+
 /// Every `[material]` and `[materials.<name>]` table of every committed study file: an
 /// unknown model, and each parameter left out, are rejected at load by an error naming the
 /// table's key (`material.model`, `material.poisson_ratio`) with its line, never a panic.
@@ -324,7 +331,9 @@ fn every_material_table_rejects_an_unknown_model_and_a_missing_parameter() {
         }
         let name = p.file_name().unwrap().to_string_lossy().into_owned();
         let doc: Value = std::fs::read_to_string(&p).unwrap().parse().unwrap();
-        let mut tables = vec![("material".to_string(), doc["material"].clone())];
+        // A scene names its materials only (`[materials.<name>]`).
+        let mut tables: Vec<(String, Value)> =
+            doc.get("material").map(|m| ("material".to_string(), m.clone())).into_iter().collect();
         if let Some(named) = doc.get("materials").and_then(|m| m.as_table()) {
             tables.extend(named.iter().map(|(k, t)| (format!("materials.{k}"), t.clone())));
         }
@@ -371,7 +380,7 @@ fn every_study_kind_has_a_probe() {
             let doc: Value = std::fs::read_to_string(&p).unwrap().parse().unwrap();
             let problem = doc.get("problem").and_then(|v| v.as_str()).unwrap_or("");
             assert!(
-                ["column", "compaction", "cantilever", "manufactured", "dynamics"].contains(&problem),
+                ["column", "compaction", "cantilever", "manufactured", "dynamics", "scene"].contains(&problem),
                 "{}: no probe for problem {problem:?}",
                 p.display()
             );
