@@ -55,6 +55,13 @@ impl<const D: usize> MaterialPoints<D> {
     /// Add one point with domain half-lengths `half` and density `density`.
     pub fn push(&mut self, x: SVector<f64, D>, half: SVector<f64, D>, density: f64) {
         let vol: f64 = half.iter().map(|h| 2.0 * h).product();
+        self.push_with_volume(x, half, vol, density);
+    }
+
+    /// Add one point with domain half-lengths `half`, its own volume `vol` (a point whose
+    /// lattice cell a body's boundary cuts carries the volume of the part inside, which its
+    /// box domain need not equal) and density `density`.
+    pub fn push_with_volume(&mut self, x: SVector<f64, D>, half: SVector<f64, D>, vol: f64, density: f64) {
         self.position.push(x);
         self.position0.push(x);
         self.half_length0.push(half);

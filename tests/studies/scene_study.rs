@@ -57,6 +57,35 @@ fn scene_compaction_equals_the_compaction_kind() {
     );
 }
 
+/// The §5.1 column as a laterally confined block: every vertical line is the 1D column, so
+/// its eq (46) error equals the column kind's committed answers (iGIMP and MPM, 2 points per
+/// cell, 16 and 32 elements, W = 40,000) to 1e-9.
+#[test]
+fn scene_column_equals_the_column_kinds_closed_form_errors() {
+    let study = SceneStudy::load(&root().join("studies/scene-column.toml")).unwrap();
+    let run = run_in_memory(&study, "scene-column.toml", Tier::Quick).unwrap();
+    let reference = committed("column");
+    let mut compared = 0;
+    for c in &run.results.cases {
+        let elements = (50.0 / c.h).round() as i64;
+        let id = format!("{}-w40000-e{elements}-p2-s20", c.method.name());
+        let r = reference["cases"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["id"] == id.as_str())
+            .unwrap_or_else(|| panic!("no column case {id}"));
+        let want = r["stress_error"].as_f64().unwrap();
+        let got = c.measures["stress-error"];
+        assert!(
+            (got - want).abs() <= 1e-9 * want.abs(),
+            "{id}: scene {got:e}, column {want:e}"
+        );
+        compared += 1;
+    }
+    assert_eq!(compared, 4);
+}
+
 /// The platen patch tests (2D and 3D, every family and element) and the large compression's
 /// exact methods pass their checks in the quick tier.
 #[test]
@@ -144,6 +173,18 @@ const MALFORMED: &[(&str, &str, &str, &str)] = &[
     ("expectation of an unknown sweep", "sweep = \"base\"\ntolerance", "sweep = \"fine\"\ntolerance", "expect_reference[0].sweep"),
     ("negative tolerance", "tolerance = 1.0e-8", "tolerance = -1.0e-8", "expect_reference[0].tolerance"),
     ("no materials", "[materials.soil]", "[materialz.soil]", "materialz"),
+    ("box and polygon", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }\npolygon = [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]]", "bodies[0]"),
+    ("neither box nor polygon", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }", "", "bodies[0]"),
+    ("polygon of 5 vertices", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }", "polygon = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.5], [0.0, 1.0]]", "bodies[0].polygon"),
+    ("non-convex polygon", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }", "polygon = [[0.0, 0.0], [2.0, 0.0], [0.5, 0.5], [0.0, 1.0]]", "bodies[0].polygon[2]"),
+    ("polygon with a repeated vertex", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }", "polygon = [[0.0, 0.0], [2.0, 0.0], [2.0, 0.0], [0.0, 1.0]]", "bodies[0].polygon"),
+    ("polygon outside the grid", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }", "polygon = [[0.0, 0.0], [4.0, 0.0], [0.0, 1.0]]", "bodies[0].polygon"),
+    ("non-finite polygon vertex", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }", "polygon = [[0.0, 0.0], [2.0, nan], [0.0, 1.0]]", "bodies[0].polygon[1][1]"),
+    ("triangle meshed by FEM", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }", "polygon = [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]]", "bodies[0].polygon"),
+    ("reference of an unknown FEM sweep", "reference = { value = 40.0,", "reference = { fem_sweep = \"fine\",", "measures[0].reference.fem_sweep"),
+    ("FEM-sweep reference of a material point sweep", "reference = { value = 40.0,", "reference = { fem_sweep = \"base\",", "measures[0].reference.fem_sweep"),
+    ("column error with a region", "kind = \"reaction\"", "kind = \"column-stress-error\"", "measures[0].region"),
+    ("unknown sweep linear solver", "points_per_cell = [2]", "points_per_cell = [2]\nlinear_solver = \"qr\"", "linear_solver"),
 ];
 
 /// The line an error names: "<file>:<line>: …" (the validator) or "… at line <line>, …"

@@ -16,8 +16,8 @@ use igimp::study::compaction::CompactionStudy;
 use igimp::study::dynamics::DynamicStudy;
 use igimp::study::engine::{self, StudyKind};
 use igimp::study::manufactured::ManufacturedStudy;
-use igimp::study::scene::SceneStudy;
 use igimp::study::results::CaseRecordOf;
+use igimp::study::scene::SceneStudy;
 use igimp::study::{StudyError, Tier};
 use std::collections::BTreeSet;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -332,8 +332,11 @@ fn every_material_table_rejects_an_unknown_model_and_a_missing_parameter() {
         let name = p.file_name().unwrap().to_string_lossy().into_owned();
         let doc: Value = std::fs::read_to_string(&p).unwrap().parse().unwrap();
         // A scene names its materials only (`[materials.<name>]`).
-        let mut tables: Vec<(String, Value)> =
-            doc.get("material").map(|m| ("material".to_string(), m.clone())).into_iter().collect();
+        let mut tables: Vec<(String, Value)> = doc
+            .get("material")
+            .map(|m| ("material".to_string(), m.clone()))
+            .into_iter()
+            .collect();
         if let Some(named) = doc.get("materials").and_then(|m| m.as_table()) {
             tables.extend(named.iter().map(|(k, t)| (format!("materials.{k}"), t.clone())));
         }
@@ -380,7 +383,15 @@ fn every_study_kind_has_a_probe() {
             let doc: Value = std::fs::read_to_string(&p).unwrap().parse().unwrap();
             let problem = doc.get("problem").and_then(|v| v.as_str()).unwrap_or("");
             assert!(
-                ["column", "compaction", "cantilever", "manufactured", "dynamics", "scene"].contains(&problem),
+                [
+                    "column",
+                    "compaction",
+                    "cantilever",
+                    "manufactured",
+                    "dynamics",
+                    "scene"
+                ]
+                .contains(&problem),
                 "{}: no probe for problem {problem:?}",
                 p.display()
             );

@@ -54,6 +54,14 @@ impl Scene {
                 "must move one component (a smooth platen)",
             ));
         };
+        if body.bounds.is_none() {
+            return Err(err(
+                format!("{key}.body"),
+                format!("{body_name:?}"),
+                "must be a box body (the closed form is a block's)",
+            ));
+        }
+        let bounds = body.bounding_box();
         let material = &self.materials[&body.material];
         if material.model() != "linear-elastic" {
             return Err(err(
@@ -63,17 +71,17 @@ impl Scene {
             ));
         }
         let (young, poisson) = self.hencky_parameters(key)?;
-        let height = body.bounds.max[axis] - body.bounds.min[axis];
+        let height = bounds.max[axis] - bounds.min[axis];
         Ok(Platen {
             dimension: self.dimension,
             axis,
             delta,
             ramp: load.ramp.clone(),
             height,
-            min: body.bounds.min.clone(),
+            min: bounds.min.clone(),
             area: (0..self.dimension)
                 .filter(|&a| a != axis)
-                .map(|a| body.bounds.max[a] - body.bounds.min[a])
+                .map(|a| bounds.max[a] - bounds.min[a])
                 .product(),
             young,
             poisson,

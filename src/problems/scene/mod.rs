@@ -3,13 +3,16 @@
 //! or by the FEM elements of the dimension ([`solve`]). The study kind `problem = "scene"`
 //! reads them from a study file.
 
+mod build;
 mod closed_form;
+pub mod geometry;
 mod solve;
 mod spec;
 mod validate;
 
+pub use build::check_resolution;
 pub use closed_form::Platen;
-pub use solve::{check_resolution, methods, solve, MeasureValue, PointRecord, SceneOutcome, SceneSettings};
+pub use solve::{methods, solve, MeasureValue, PointRecord, SceneOutcome, SceneSettings};
 pub use spec::{
     axis_index, region, Body, Bounds, ClosedForm, Components, GridSection, Load, LoadKind, Measure,
     MeasureKind, Plane, Reference, Region, Scene, Support, AXES,

@@ -6,13 +6,9 @@ use super::spec::{axis_index, region, LoadKind, MeasureKind, Region, Scene};
 use crate::basis::method::Method;
 use crate::basis::{Basis, DomainUpdate};
 use crate::discretise::ghost::GhostSettings;
-use crate::fem::{
-    ContinuumFem, ElementFamily, ElementMesh, FemLoads, HexElement, HexMesh, PlaneFemSettings, PlaneMesh,
-    QuadElement,
-};
+use crate::fem::{ContinuumFem, ElementFamily, FemLoads, HexElement, PlaneFemSettings, QuadElement};
 use crate::material::kinematics::PointState;
 use crate::mesh::grid::Grid;
-use crate::mpm::particles::MaterialPoints;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
 use crate::solver::dynamics::BodyForce;
 use crate::solver::error::{InputError, SolveError};
@@ -84,24 +80,16 @@ pub fn solve(scene: &Scene, settings: &SceneSettings, method: Method) -> Result<
     match (scene.dimension, method) {
         (2, Method::MaterialPoint(b)) => solve_mpm::<2>(scene, settings, b),
         (3, Method::MaterialPoint(b)) => solve_mpm::<3>(scene, settings, b),
-        (2, Method::FEM_Q4) => solve_fem::<2, _>(scene, settings, |o, s, c| {
-            PlaneMesh::structured(o, s, c, QuadElement::Q4)
-        }),
-        (2, Method::FEM_Q8) => solve_fem::<2, _>(scene, settings, |o, s, c| {
-            PlaneMesh::structured(o, s, c, QuadElement::Q8)
-        }),
-        (3, Method::FEM_HEX8) => solve_fem::<3, _>(scene, settings, |o, s, c| {
-            HexMesh::cuboid(o, s, c, HexElement::Hex8)
-        }),
-        (3, Method::FEM_HEX20) => solve_fem::<3, _>(scene, settings, |o, s, c| {
-            HexMesh::cuboid(o, s, c, HexElement::Hex20)
-        }),
+        (2, Method::FEM_Q4) => solve_fem::<2, _>(scene, settings, QuadElement::Q4),
+        (2, Method::FEM_Q8) => solve_fem::<2, _>(scene, settings, QuadElement::Q8),
+        (3, Method::FEM_HEX8) => solve_fem::<3, _>(scene, settings, HexElement::Hex8),
+        (3, Method::FEM_HEX20) => solve_fem::<3, _>(scene, settings, HexElement::Hex20),
         (d, m) => Err(m.unsupported(&format!("a scene in dimension {d}"), methods(d))),
     }
 }
 
 /// Cells of `length` at `h`, which must divide it.
-fn cells(key: &str, length: f64, h: f64) -> Result<usize, InputError> {
+pub(super) fn cells(key: &str, length: f64, h: f64) -> Result<usize, InputError> {
     let n = length / h;
     if !(n.is_finite()
         && (n - n.round()).abs() <= 1e-9 * n.max(1.0)
@@ -124,18 +112,22 @@ fn fixed_array<const D: usize>(v: &[f64]) -> [f64; D] {
 /// The node dofs (node, axis, value) of every support (value 0) and displacement load, by
 /// the name of its region, from the nodes' positions: an error names a region on no node.
 /// Calls its argument with every node and its position.
-type NodeVisitor<'a> = &'a dyn Fn(&mut dyn FnMut(usize, &[f64]));
+pub(super) type NodeVisitor<'a> = &'a dyn Fn(&mut dyn FnMut(usize, &[f64]));
 
 /// The reaction component `axis` summed over the (node, axis) dofs of a region.
 type ReactionSum<'a> = &'a dyn Fn(&[(usize, usize)], usize) -> f64;
 
-type NamedDofs = Vec<(
+pub(super) type NamedDofs = Vec<(
     String,
     Vec<(usize, usize)>,
     Option<(Vec<(usize, usize, f64)>, Ramp)>,
 )>;
 
-fn region_dofs(scene: &Scene, h: f64, positions: NodeVisitor<'_>) -> Result<NamedDofs, InputError> {
+pub(super) fn region_dofs(
+    scene: &Scene,
+    h: f64,
+    positions: NodeVisitor<'_>,
+) -> Result<NamedDofs, InputError> {
     let tol = 1e-9 * h;
     let d = scene.dimension;
     let nodes_in = |key: &str, r: Region<'_>| -> Result<Vec<usize>, InputError> {
@@ -209,16 +201,12 @@ fn tabled_body_force<const D: usize>(
     if tabled.is_empty() {
         return None;
     }
-    let bodies: Vec<_> = scene
-        .bodies
-        .iter()
-        .map(|b| (b.bounds.clone(), b.density))
-        .collect();
+    let bodies = scene.bodies.clone();
     Some(BodyForce::new(move |x: &SVector<f64, D>, t: f64| {
         let rho = bodies
             .iter()
-            .find(|(b, _)| b.contains(x.as_slice(), 1e-12))
-            .map_or(0.0, |(_, r)| *r);
+            .find(|b| b.contains(x.as_slice(), 1e-12))
+            .map_or(0.0, |b| b.density);
         tabled.iter().map(|(g, r)| g * (rho * r.factor(t))).sum()
     }))
 }
@@ -235,7 +223,33 @@ fn energy(state: &PointState, volume0: f64, young: f64, poisson: f64) -> f64 {
 struct Probe<'a> {
     displacement: &'a dyn Fn(&[f64], usize, bool) -> f64,
     reaction: ReactionSum<'a>,
-    energy: &'a dyn Fn(f64, f64) -> f64,
+    /// Calls its argument with every integration point's initial position, initial volume
+    /// and committed state.
+    points: PointVisitor<'a>,
+}
+
+/// Calls its argument with each integration point's X₀, V₀ and state.
+type PointVisitor<'a> = &'a dyn Fn(&mut dyn FnMut(&[f64], f64, &PointState));
+
+/// Eq (46) of the column, for a body under one gravity load along an axis: Σ_p |σ_aa,p −
+/// σ(Z_p)| V₀_p / (ρ g V L) with σ(Z) = −ρ g (L − Z) (eq 42, equilibrium alone), Z the height
+/// above the body's base along the gravity's axis a, L the body's height and V its volume;
+/// in one dimension V = L and this is the column kind's measure.
+fn column_stress_error(scene: &Scene, points: PointVisitor<'_>) -> f64 {
+    let Some((axis, g)) = super::spec::column_axis(scene) else {
+        return f64::NAN;
+    };
+    let body = &scene.bodies[0];
+    let bb = body.bounding_box();
+    let (base, length) = (bb.min[axis], bb.max[axis] - bb.min[axis]);
+    let unit_weight = body.density * g;
+    let (mut sum, mut volume) = (0.0, 0.0);
+    points(&mut |x0, v0, state| {
+        let exact = -unit_weight * (length - (x0[axis] - base));
+        sum += (state.cauchy()[(axis, axis)] - exact).abs() * v0;
+        volume += v0;
+    });
+    sum / (unit_weight * volume * length)
 }
 
 /// Every measure of `scene` from `probe`, with the region dofs `named`.
@@ -262,8 +276,11 @@ fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>) -> Vec<f64
                 }
                 MeasureKind::StrainEnergy => {
                     let (e, nu) = scene.hencky_parameters("").unwrap_or((f64::NAN, f64::NAN));
-                    (probe.energy)(e, nu)
+                    let mut sum = 0.0;
+                    (probe.points)(&mut |_, v0, state| sum += energy(state, v0, e, nu));
+                    sum
                 }
+                MeasureKind::ColumnStressError => column_stress_error(scene, probe.points),
             }
         })
         .collect()
@@ -302,25 +319,7 @@ fn solve_mpm<const D: usize>(
         n[a] = cells(&format!("grid.extent[{a}]"), scene.grid.extent[a], h)?;
     }
     let grid = Grid::try_new(fixed_array::<D>(&scene.grid.origin), [h; D], n)?;
-    let mut points: Option<MaterialPoints<D>> = None;
-    for b in &scene.bodies {
-        let filled = MaterialPoints::fill_box(
-            &grid,
-            fixed_array::<D>(&b.bounds.min),
-            fixed_array::<D>(&b.bounds.max),
-            [s.points_per_cell; D],
-            b.density,
-        )?;
-        match &mut points {
-            None => points = Some(filled),
-            Some(all) => {
-                for p in 0..filled.len() {
-                    all.push(filled.position[p], filled.half_length[p], b.density);
-                }
-            }
-        }
-    }
-    let points = points.expect("a scene has a body");
+    let points = super::build::fill_points(scene, &grid, s.points_per_cell)?;
     let named = region_dofs(scene, h, &|f| {
         for k in 0..grid.num_nodes() {
             f(k, grid.node_position(k).as_slice())
@@ -383,10 +382,10 @@ fn solve_mpm<const D: usize>(
                 .map(|&(n, a)| solver.reaction(n, a))
                 .sum()
         };
-        let energy = |e: f64, nu: f64| {
-            (0..pts.len())
-                .map(|p| energy(&pts.state[p], pts.volume0[p], e, nu))
-                .sum()
+        let points = |f: &mut dyn FnMut(&[f64], f64, &PointState)| {
+            for p in 0..pts.len() {
+                f(pts.position0[p].as_slice(), pts.volume0[p], &pts.state[p]);
+            }
         };
         read_measures(
             scene,
@@ -394,7 +393,7 @@ fn solve_mpm<const D: usize>(
             &Probe {
                 displacement: &displacement,
                 reaction: &reaction,
-                energy: &energy,
+                points: &points,
             },
         )
     };
@@ -424,27 +423,11 @@ fn solve_mpm<const D: usize>(
 fn solve_fem<const D: usize, E: ElementFamily<D>>(
     scene: &Scene,
     s: &SceneSettings,
-    mesh: impl Fn(SVector<f64, D>, SVector<f64, D>, [usize; D]) -> Result<ElementMesh<D, E>, InputError>,
+    element: E,
 ) -> Result<SceneOutcome, InputError> {
-    let [body] = &scene.bodies[..] else {
-        return Err(InputError::new(
-            "bodies",
-            format!("{} bodies", scene.bodies.len()),
-            "must be one box for the FEM methods (meshes of several bodies are not joined)",
-        ));
-    };
     let h = s.element_size;
-    let mut n = [0; D];
-    for a in 0..D {
-        n[a] = cells(
-            &format!("bodies[0].box (axis {a})"),
-            body.bounds.max[a] - body.bounds.min[a],
-            h,
-        )?;
-    }
-    let lo = SVector::<f64, D>::from_iterator(body.bounds.min.iter().copied());
-    let hi = SVector::<f64, D>::from_iterator(body.bounds.max.iter().copied());
-    let mesh = mesh(lo, hi - lo, n)?;
+    let mesh = super::build::body_mesh::<D, E>(scene, h, element)?;
+    let body = &scene.bodies[0];
     let named = region_dofs(scene, h, &|f| {
         for (k, x) in mesh.nodes.iter().enumerate() {
             f(k, x.as_slice())
@@ -494,10 +477,11 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
                 .map(|&(n, a)| fem.reaction(n, a))
                 .sum()
         };
-        let energy = |e: f64, nu: f64| {
-            (0..fem.gauss.len())
-                .map(|q| energy(&fem.gauss.state[q], fem.gauss.volume0[q], e, nu))
-                .sum()
+        let g = &fem.gauss;
+        let points = |f: &mut dyn FnMut(&[f64], f64, &PointState)| {
+            for q in 0..g.len() {
+                f(g.position0[q].as_slice(), g.volume0[q], &g.state[q]);
+            }
         };
         read_measures(
             scene,
@@ -505,7 +489,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
             &Probe {
                 displacement: &displacement,
                 reaction: &reaction,
-                energy: &energy,
+                points: &points,
             },
         )
     };
@@ -520,63 +504,4 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
         size: fem.mesh.num_elements(),
         points: vec![],
     })
-}
-
-/// What a case needs of its resolution, checked without building it: h divides the grid's
-/// extent (material points) or the body (FEM); the bodies lie on the point lattice of spacing
-/// h / points per cell; every support and displacement load holds a node (of the grid, or of
-/// the body's mesh for FEM). Errors name the key.
-pub fn check_resolution(scene: &Scene, s: &SceneSettings, method: Method) -> Result<(), InputError> {
-    let h = s.element_size;
-    let d = scene.dimension;
-    let mp = method.uses_material_points();
-    let mut n = vec![0usize; d];
-    for a in 0..d {
-        n[a] = cells(&format!("grid.extent[{a}]"), scene.grid.extent[a], h)?;
-    }
-    for (i, b) in scene.bodies.iter().enumerate() {
-        let step = if mp { h / s.points_per_cell as f64 } else { h };
-        for a in 0..d {
-            let what = if mp {
-                "h / points per cell"
-            } else {
-                "h (the FEM mesh)"
-            };
-            cells(
-                &format!("bodies[{i}].box.min[{a}]"),
-                b.bounds.min[a] - scene.grid.origin[a] + step,
-                step,
-            )
-            .and_then(|_| {
-                cells(
-                    &format!("bodies[{i}].box.max[{a}]"),
-                    b.bounds.max[a] - b.bounds.min[a],
-                    step,
-                )
-            })
-            .map_err(|e| {
-                InputError::new(
-                    e.field,
-                    e.value,
-                    format!("must lie on the lattice of {what} = {step} from the grid's origin"),
-                )
-            })?;
-        }
-    }
-    // The grid's nodes (material points) or those of the one body's box (FEM, linear lattice).
-    let lattice = |f: &mut dyn FnMut(usize, &[f64])| {
-        let total: usize = n.iter().map(|c| c + 1).product();
-        let mut x = vec![0.0; d];
-        for k in 0..total {
-            let mut r = k;
-            for a in 0..d {
-                x[a] = scene.grid.origin[a] + (r % (n[a] + 1)) as f64 * h;
-                r /= n[a] + 1;
-            }
-            if mp || scene.bodies[0].bounds.contains(&x, 1e-9 * h) {
-                f(k, &x);
-            }
-        }
-    };
-    region_dofs(scene, h, &lattice).map(|_| ())
 }

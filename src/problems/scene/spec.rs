@@ -38,14 +38,20 @@ pub struct Plane {
     pub at: f64,
 }
 
-/// A body: a box of material filled with points (or meshed, for FEM).
+/// A body: a box, or in 2D a convex polygon of 3 or 4 vertices, of material filled with
+/// points (or meshed, for FEM).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Body {
     pub name: String,
     /// The body's box; its sides are whole multiples of h / points per cell.
-    #[serde(rename = "box")]
-    pub bounds: Bounds,
+    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
+    pub bounds: Option<Bounds>,
+    /// Or a convex polygon (2D): the points fill the lattice cells of h / points per cell
+    /// that it cuts, each with the volume and centroid of its part inside
+    /// ([`super::geometry::clip_square`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polygon: Option<Vec<[f64; 2]>>,
     /// The name of a `[materials.<name>]` table.
     pub material: String,
     /// Mass per unit initial volume (default 1).
@@ -146,6 +152,27 @@ pub enum MeasureKind {
     /// Σ V₀ W(εᵉ) over the points, W = μ εᵉ:εᵉ + λ/2 (tr εᵉ)² (Hencky; needs the material's
     /// `young_modulus` and `poisson_ratio`).
     StrainEnergy,
+    /// The column's stress error, eq (46), of a one-box scene under one gravity load along an
+    /// axis: Σ_p |σ_p − σ(Z_p)| V₀_p / (ρ g V L) against σ(Z) = −ρ g (L − Z), Z the height above
+    /// the base (reference/README.md item 66).
+    ColumnStressError,
+}
+
+/// The axis and magnitude of a scene's one gravity load when it has one box body and its
+/// only gravity load lies along an axis (the column's setting).
+pub fn column_axis(scene: &Scene) -> Option<(usize, f64)> {
+    let [body] = &scene.bodies[..] else { return None };
+    body.bounds.as_ref()?;
+    let gravity: Vec<&Vec<f64>> = scene
+        .loads
+        .iter()
+        .filter(|l| l.kind == LoadKind::Gravity)
+        .filter_map(|l| l.vector.as_ref())
+        .collect();
+    let [g] = gravity[..] else { return None };
+    let along: Vec<usize> = (0..g.len()).filter(|&a| g[a] != 0.0).collect();
+    let [axis] = along[..] else { return None };
+    (g[axis] < 0.0).then_some((axis, -g[axis]))
 }
 
 /// A closed form a measure is compared with.
@@ -167,6 +194,10 @@ pub struct Reference {
     pub value: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub closed_form: Option<ClosedForm>,
+    /// Or the scene itself solved by the one FEM method of this sweep (of the study), its three
+    /// finest element sizes extrapolated (Richardson, with their grid convergence index).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fem_sweep: Option<String>,
     /// A closed form's body (its box and material) and displacement load (its platen).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub body: Option<String>,
@@ -347,14 +378,22 @@ impl Scene {
         for (i, b) in self.bodies.iter().enumerate() {
             let key = format!("bodies[{i}]");
             self.name(&format!("{key}.name"), &b.name, &mut names)?;
-            b.bounds.check(&format!("{key}.box"), d, true)?;
-            if !(b.bounds.contains(&grid.min, f64::INFINITY)
-                && grid.contains(&b.bounds.min, 1e-12)
-                && grid.contains(&b.bounds.max, 1e-12))
-            {
+            match (&b.bounds, &b.polygon) {
+                (Some(bx), None) => bx.check(&format!("{key}.box"), d, true)?,
+                (None, Some(p)) => super::geometry::check_polygon(&format!("{key}.polygon"), p, d)?,
+                _ => {
+                    return Err(err(
+                        key.clone(),
+                        "box and polygon",
+                        "must give a box or a polygon, exactly one",
+                    ))
+                }
+            }
+            let bb = b.bounding_box();
+            if !(grid.contains(&bb.min, 1e-12) && grid.contains(&bb.max, 1e-12)) {
                 return Err(err(
-                    format!("{key}.box"),
-                    format!("{:?} .. {:?}", b.bounds.min, b.bounds.max),
+                    format!("{key}.{}", if b.polygon.is_some() { "polygon" } else { "box" }),
+                    format!("{:?} .. {:?}", bb.min, bb.max),
                     format!("must lie inside the grid {:?} .. {:?}", grid.min, grid.max),
                 ));
             }
@@ -380,12 +419,13 @@ impl Scene {
                 ));
             }
             for (j, o) in self.bodies[..i].iter().enumerate() {
-                let overlap =
-                    (0..d).all(|a| b.bounds.min[a] < o.bounds.max[a] && o.bounds.min[a] < b.bounds.max[a]);
+                let (a, c) = (b.bounding_box(), o.bounding_box());
+                let boxes = (0..d).all(|x| a.min[x] < c.max[x] && c.min[x] < a.max[x]);
+                let overlap = boxes && (d == 3 || super::geometry::overlap(&b.outline(), &o.outline()));
                 if overlap {
                     return Err(err(
-                        format!("{key}.box"),
-                        format!("{:?} .. {:?}", b.bounds.min, b.bounds.max),
+                        format!("{key}.{}", if b.polygon.is_some() { "polygon" } else { "box" }),
+                        format!("{:?} .. {:?}", a.min, a.max),
                         format!("must not overlap bodies[{j}] ({:?})", o.name),
                     ));
                 }

@@ -150,6 +150,23 @@ impl Scene {
                 }
                 self.component(&key, m)?;
             }
+            MeasureKind::ColumnStressError => {
+                for (f, g) in [
+                    ("at", m.at.is_some()),
+                    ("region", m.region.is_some()),
+                    ("component", m.component.is_some()),
+                    ("domain_edge", m.domain_edge),
+                ] {
+                    refuse(f, g)?;
+                }
+                if super::spec::column_axis(self).is_none() {
+                    return Err(err(
+                        format!("{key}.kind"),
+                        "column-stress-error",
+                        "needs one box body and one gravity load along an axis, pointing to its negative side",
+                    ));
+                }
+            }
             MeasureKind::StrainEnergy => {
                 for (f, g) in [
                     ("at", m.at.is_some()),
@@ -197,6 +214,17 @@ impl Scene {
                 "must say where the reference comes from",
             ));
         }
+        if r.fem_sweep.is_some() {
+            // The study checks that it names a sweep of one FEM method.
+            if r.value.is_some() || r.closed_form.is_some() || r.body.is_some() || r.load.is_some() {
+                return Err(err(
+                    key,
+                    "fem_sweep with value, closed_form, body or load",
+                    "must give exactly one of value, closed_form or fem_sweep",
+                ));
+            }
+            return Ok(());
+        }
         match (r.value, r.closed_form) {
             (Some(v), None) => {
                 if !v.is_finite() {
@@ -224,7 +252,7 @@ impl Scene {
             _ => Err(err(
                 key,
                 "value and closed_form",
-                "must give exactly one of value or closed_form",
+                "must give exactly one of value, closed_form or fem_sweep",
             )),
         }
     }

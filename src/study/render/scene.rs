@@ -132,7 +132,7 @@ pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> Strin
     );
     let _ = writeln!(
         s,
-        "A scene in {}D: {} bod{} ({}), {} support(s), {} load(s), {} load steps. Errors are relative to the reference's magnitude.\n",
+        "A scene in {}D: {} bod{} ({}), {} support(s), {} load(s), {} load steps. Errors are relative to the reference's magnitude (absolute where the reference is 0).\n",
         study.dimension,
         study.bodies.len(),
         if study.bodies.len() == 1 { "y" } else { "ies" },
@@ -146,6 +146,9 @@ pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> Strin
         let _ = writeln!(s, "| {name} | {:.10e} | {} |", v.value, super::md_text(&v.source));
     }
     s.push('\n');
+    if !r.measures.gci.is_empty() {
+        s.push_str(&super::gci_markdown(&r.measures.gci));
+    }
     for sw in &study.sweeps {
         let cases = r.sweep(&sw.id);
         if cases.is_empty() {
@@ -186,7 +189,7 @@ pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> Strin
                 if let Some(reference) = r.measures.references.get(&m.name) {
                     let e = v
                         .filter(|_| c.solve.status == CaseStatus::Converged)
-                        .map(|v| (v - reference.value).abs() / reference.value.abs().max(f64::MIN_POSITIVE));
+                        .map(|v| reference.error(v));
                     let _ = write!(s, " {} |", e3(e));
                 }
             }

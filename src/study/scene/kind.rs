@@ -5,7 +5,7 @@
 
 use super::{RateRecord, ReferenceValue, SceneCase, SceneMeasures, SceneRecord, SceneResults, SceneStudy};
 use crate::problems::scene::{solve, ClosedForm, Scene};
-use crate::study::checks::{check_at_most, check_rate, CheckRecord};
+use crate::study::checks::{check_at_most, check_rate, CheckRecord, GciRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{CaseStatus, SolveRecord, SweepIndex};
 use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
@@ -124,8 +124,37 @@ fn measures(results: &SceneResults) -> SceneMeasures {
     let scene = study.scene();
     let steps = study.load_steps.max(1) as usize;
     let mut references = BTreeMap::new();
+    let mut gci = vec![];
     for m in &scene.measures {
         let Some(r) = &m.reference else { continue };
+        if let Some(sweep) = &r.fem_sweep {
+            let levels: Vec<(f64, f64)> = results
+                .sweep(sweep)
+                .into_iter()
+                .filter(|c| c.solve.status == CaseStatus::Converged)
+                .filter_map(|c| Some((c.h, *c.measures.get(&m.name)?)))
+                .collect();
+            let method = results
+                .sweep(sweep)
+                .first()
+                .map_or("FEM".to_string(), |c| c.method.name().to_string());
+            let record = GciRecord::of(sweep, method.clone(), &m.name, levels);
+            if let Some(g) = &record.gci {
+                references.insert(
+                    m.name.clone(),
+                    ReferenceValue {
+                        value: g.extrapolated,
+                        history: vec![],
+                        source: format!(
+                            "{} ({method} of sweep {sweep} at h = {}, {}, {} extrapolated, observed order {:.2}, GCI_fine {:.2e}; {})",
+                            r.source, g.h[0], g.h[1], g.h[2], g.order, g.gci_fine, record.note
+                        ),
+                    },
+                );
+            }
+            gci.push(record);
+            continue;
+        }
         let at = |t: f64| -> Option<f64> {
             match r.closed_form {
                 None => r.value,
@@ -164,7 +193,7 @@ fn measures(results: &SceneResults) -> SceneMeasures {
             let mut series: BTreeMap<Series, Vec<(f64, f64)>> = BTreeMap::new();
             for c in cases.iter().filter(|c| c.solve.status == CaseStatus::Converged) {
                 if let Some(v) = c.measures.get(name) {
-                    let e = (v - r.value).abs() / r.value.abs().max(f64::MIN_POSITIVE);
+                    let e = r.error(*v);
                     series
                         .entry((c.method.name().to_string(), c.points_per_cell))
                         .or_default()
@@ -193,14 +222,18 @@ fn measures(results: &SceneResults) -> SceneMeasures {
             }
         }
     }
-    SceneMeasures { references, rates }
+    SceneMeasures {
+        references,
+        gci,
+        rates,
+    }
 }
 
 /// The largest relative error of `case`'s measure `name` against `r`, at the end and after
 /// every step of a history (whose steps are the study's load steps).
 fn largest_error(case: &SceneRecord, name: &str, r: &ReferenceValue) -> Option<f64> {
-    let scale = r.value.abs().max(f64::MIN_POSITIVE);
-    let mut worst = (case.measures.get(name)? - r.value).abs() / scale;
+    let scale = if r.value == 0.0 { 1.0 } else { r.value.abs() };
+    let mut worst = r.error(*case.measures.get(name)?);
     if let Some(h) = case.histories.get(name) {
         if h.len() == r.history.len() {
             for (v, e) in h.iter().zip(&r.history) {

@@ -40,6 +40,11 @@ pub struct SceneSweep {
     pub element_sizes: Vec<f64>,
     /// Points per cell along each axis (material point methods; FEM cases ignore it).
     pub points_per_cell: Vec<i64>,
+    /// `cg`: multigrid-preconditioned conjugate gradients for every case (ids gain `-cg`);
+    /// absent: the direct default (LDLᵀ for FEM; LDLᵀ where the tangent is symmetric, LU
+    /// otherwise, for material points).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linear_solver: Option<crate::solver::linear::LinearSolver>,
     /// Load steps of this sweep (default: the study's `load_steps`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub load_steps: Option<i64>,
@@ -157,6 +162,15 @@ pub struct ReferenceValue {
     pub source: String,
 }
 
+impl ReferenceValue {
+    /// The error of `v` against this reference: relative to its magnitude, or absolute when
+    /// the reference is 0 (a measure that is itself an error, e.g. the column's eq 46).
+    pub fn error(&self, v: f64) -> f64 {
+        let scale = if self.value == 0.0 { 1.0 } else { self.value.abs() };
+        (v - self.value).abs() / scale
+    }
+}
+
 /// A fitted rate of a measure's error.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RateRecord {
@@ -173,6 +187,9 @@ pub struct RateRecord {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SceneMeasures {
     pub references: BTreeMap<String, ReferenceValue>,
+    /// The grid convergence index of each FEM-sweep reference.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub gci: Vec<crate::study::checks::GciRecord>,
     #[serde(default)]
     pub rates: Vec<RateRecord>,
 }
@@ -239,7 +256,7 @@ impl SceneStudy {
             newton: self.newton.settings(),
             ghost: self.ghost,
             domain_update: Default::default(),
-            linear_solver: Default::default(),
+            linear_solver: s.linear_solver.unwrap_or_default(),
         }
     }
 
@@ -256,6 +273,17 @@ impl SceneStudy {
         }
         if let Some(n) = s.load_steps {
             id.push_str(&format!("-steps{n}"));
+        }
+        match s.linear_solver {
+            None | Some(crate::solver::linear::LinearSolver::Auto) => {}
+            Some(crate::solver::linear::LinearSolver::Iterative) => id.push_str("-cg"),
+            Some(other) => id.push_str(&format!(
+                "-{}",
+                serde_json::to_value(other)
+                    .ok()
+                    .and_then(|v| v.as_str().map(str::to_string))
+                    .unwrap_or_default()
+            )),
         }
         id
     }

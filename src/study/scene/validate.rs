@@ -104,6 +104,34 @@ impl SceneStudy {
     }
 
     fn check_expectations(&self, chk: &Checker<'_>) -> Result<(), StudyError> {
+        for (i, m) in self.measures.iter().enumerate() {
+            let Some(sweep) = m.reference.as_ref().and_then(|r| r.fem_sweep.as_ref()) else {
+                continue;
+            };
+            let key = format!("measures[{i}].reference.fem_sweep");
+            let s = self
+                .sweeps
+                .iter()
+                .find(|s| &s.id == sweep)
+                .ok_or_else(|| chk.err(&key, format!("{sweep:?}"), "must name a sweep"))?;
+            for tier in [Tier::Full, Tier::Quick] {
+                let Some((ms, sizes, _)) = self.plan(s, tier) else {
+                    return Err(chk.err(
+                        &key,
+                        format!("{sweep:?}"),
+                        "must name a sweep that every tier runs (not quick.skip)",
+                    ));
+                };
+                let distinct: BTreeSet<u64> = sizes.iter().map(|h| h.to_bits()).collect();
+                if ms.len() != 1 || !ms[0].is_fem() || distinct.len() < 3 {
+                    return Err(chk.err(
+                        &key,
+                        format!("{sweep:?}"),
+                        format!("must name a sweep of one FEM method with three or more element sizes in the {} tier", tier.name()),
+                    ));
+                }
+            }
+        }
         let measure = |key: &str, name: &str| -> Result<(), StudyError> {
             match self.measures.iter().find(|m| m.name == name) {
                 None => Err(chk.err(key, format!("{name:?}"), "must name a measure")),

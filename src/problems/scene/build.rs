@@ -1,0 +1,216 @@
+//! What a case builds from a scene's bodies: the material points (a box filled as
+//! [`MaterialPoints::fill_box`] does; a polygon's lattice cells cut to it) and the FEM mesh
+//! (a box as a structured mesh, a quadrilateral as a mapped one), and the checks of a
+//! resolution before anything is built.
+
+use super::geometry::{bilinear, clip_square, mapped_cells, Shape};
+use super::solve::{cells, region_dofs, SceneSettings};
+use super::spec::Scene;
+use crate::basis::method::Method;
+use crate::fem::{ElementFamily, ElementMesh, HexElement, QuadElement};
+use crate::mesh::grid::Grid;
+use crate::mpm::particles::MaterialPoints;
+use crate::solver::error::{require_positive, InputError};
+use nalgebra::SVector;
+
+fn fixed_array<const D: usize>(v: &[f64]) -> [f64; D] {
+    std::array::from_fn(|a| v[a])
+}
+
+/// The points of every body on `grid`, `ppc` per cell and axis.
+pub(super) fn fill_points<const D: usize>(
+    scene: &Scene,
+    grid: &Grid<D>,
+    ppc: usize,
+) -> Result<MaterialPoints<D>, InputError> {
+    let mut points: Option<MaterialPoints<D>> = None;
+    for b in &scene.bodies {
+        let filled = match b.shape() {
+            Shape::Box(bx) => MaterialPoints::fill_box(
+                grid,
+                fixed_array::<D>(&bx.min),
+                fixed_array::<D>(&bx.max),
+                [ppc; D],
+                b.density,
+            )?,
+            Shape::Polygon(p) => fill_polygon(grid, p, ppc, b.density)?,
+        };
+        match &mut points {
+            None => points = Some(filled),
+            Some(all) => {
+                for p in 0..filled.len() {
+                    all.push_with_volume(
+                        filled.position[p],
+                        filled.half_length[p],
+                        filled.volume0[p],
+                        b.density,
+                    );
+                }
+            }
+        }
+    }
+    points.ok_or_else(|| InputError::new("bodies", "[]", "must list at least one body"))
+}
+
+/// A convex polygon's points: one per lattice cell (spacing h / `ppc` from the grid's origin)
+/// it cuts, at the centroid of the part inside, with that part's area as its volume and a
+/// square domain of the same area, shrunk where it would leave the lattice cell.
+fn fill_polygon<const D: usize>(
+    grid: &Grid<D>,
+    p: &[[f64; 2]],
+    ppc: usize,
+    density: f64,
+) -> Result<MaterialPoints<D>, InputError> {
+    require_positive("density", density)?;
+    let origin = grid.origin();
+    let s = grid.spacing()[0] / ppc as f64;
+    let lo = (0..2)
+        .map(|a| p.iter().map(|v| v[a]).fold(f64::INFINITY, f64::min))
+        .collect::<Vec<_>>();
+    let hi = (0..2)
+        .map(|a| p.iter().map(|v| v[a]).fold(f64::NEG_INFINITY, f64::max))
+        .collect::<Vec<_>>();
+    let first = |a: usize| ((lo[a] - origin[a]) / s + 1e-9).floor() as i64;
+    let last = |a: usize| ((hi[a] - origin[a]) / s - 1e-9).ceil() as i64;
+    let mut points = MaterialPoints::<D>::default();
+    let full = s * s;
+    for j in first(1)..last(1) {
+        for i in first(0)..last(0) {
+            let c0 = [origin[0] + i as f64 * s, origin[1] + j as f64 * s];
+            let c1 = [c0[0] + s, c0[1] + s];
+            let (area, c) = clip_square(p, c0, c1);
+            if area <= 1e-12 * full {
+                continue;
+            }
+            let side = 0.5 * s * (area / full).sqrt();
+            let mut half = SVector::<f64, D>::zeros();
+            let mut x = SVector::<f64, D>::zeros();
+            for a in 0..2 {
+                x[a] = c[a];
+                half[a] = side.min(c[a] - c0[a]).min(c1[a] - c[a]);
+            }
+            points.push_with_volume(x, half, area, density);
+        }
+    }
+    Ok(points)
+}
+
+/// The FEM mesh of the scene's one body at element size `h` with `element`: a box as a
+/// structured mesh of cubes of h, a quadrilateral as a mapped mesh ([`mapped_cells`]).
+pub(super) fn body_mesh<const D: usize, E: ElementFamily<D>>(
+    scene: &Scene,
+    h: f64,
+    element: E,
+) -> Result<ElementMesh<D, E>, InputError> {
+    let [body] = &scene.bodies[..] else {
+        return Err(InputError::new(
+            "bodies",
+            format!("{} bodies", scene.bodies.len()),
+            "must be one body for the FEM methods (meshes of several bodies are not joined)",
+        ));
+    };
+    match body.shape() {
+        Shape::Box(bx) => {
+            let mut n = [0; D];
+            for a in 0..D {
+                n[a] = cells(&format!("bodies[0].box (axis {a})"), bx.max[a] - bx.min[a], h)?;
+            }
+            let lo = SVector::<f64, D>::from_iterator(bx.min.iter().copied());
+            let hi = SVector::<f64, D>::from_iterator(bx.max.iter().copied());
+            ElementMesh::structured(lo, hi - lo, n, element)
+        }
+        Shape::Polygon(p) if p.len() == 4 && D == 2 => {
+            let m = mapped_cells(p, h)?;
+            let mut mesh = ElementMesh::structured(
+                SVector::zeros(),
+                SVector::repeat(1.0),
+                std::array::from_fn(|a| m[a.min(1)]),
+                element,
+            )?;
+            for x in mesh.nodes.iter_mut() {
+                let y = bilinear(p, x[0], x[1]);
+                x[0] = y[0];
+                x[1] = y[1];
+            }
+            Ok(mesh)
+        }
+        Shape::Polygon(_) => Err(InputError::new(
+            "bodies[0].polygon",
+            "3 vertices",
+            "must have 4 vertices for the FEM methods (a triangle has no mapped quadrilateral mesh here)",
+        )),
+    }
+}
+
+/// The positions of `mesh`'s nodes, for [`region_dofs`].
+fn visit<const D: usize, E>(mesh: &ElementMesh<D, E>, f: &mut dyn FnMut(usize, &[f64])) {
+    for (k, x) in mesh.nodes.iter().enumerate() {
+        f(k, x.as_slice());
+    }
+}
+
+/// What a case needs of its resolution, checked without solving it: h divides the grid's
+/// extent; box bodies lie on the point lattice of h / points per cell (material points) or
+/// are whole multiples of h (FEM); the FEM mesh can be built; every support and displacement
+/// load holds a node (of the grid, or of the mesh). Errors name the key.
+pub fn check_resolution(scene: &Scene, s: &SceneSettings, method: Method) -> Result<(), InputError> {
+    let h = s.element_size;
+    let d = scene.dimension;
+    let mut n = vec![0usize; d];
+    for a in 0..d {
+        n[a] = cells(&format!("grid.extent[{a}]"), scene.grid.extent[a], h)?;
+    }
+    if method.uses_material_points() {
+        let step = h / s.points_per_cell as f64;
+        for (i, b) in scene.bodies.iter().enumerate() {
+            let Shape::Box(bx) = b.shape() else { continue };
+            for a in 0..d {
+                cells(
+                    &format!("bodies[{i}].box.min[{a}]"),
+                    bx.min[a] - scene.grid.origin[a] + step,
+                    step,
+                )
+                .and_then(|_| cells(&format!("bodies[{i}].box.max[{a}]"), bx.max[a] - bx.min[a], step))
+                .map_err(|e| {
+                    InputError::new(
+                        e.field,
+                        e.value,
+                        format!(
+                            "must lie on the lattice of h / points per cell = {step} from the grid's origin"
+                        ),
+                    )
+                })?;
+            }
+        }
+        let lattice = |f: &mut dyn FnMut(usize, &[f64])| {
+            let total: usize = n.iter().map(|c| c + 1).product();
+            let mut x = vec![0.0; d];
+            for k in 0..total {
+                let mut r = k;
+                for a in 0..d {
+                    x[a] = scene.grid.origin[a] + (r % (n[a] + 1)) as f64 * h;
+                    r /= n[a] + 1;
+                }
+                f(k, &x);
+            }
+        };
+        return region_dofs(scene, h, &lattice).map(|_| ());
+    }
+    match (d, method) {
+        (2, Method::FEM_Q4) => fem_regions::<2, _>(scene, h, QuadElement::Q4),
+        (2, Method::FEM_Q8) => fem_regions::<2, _>(scene, h, QuadElement::Q8),
+        (3, Method::FEM_HEX8) => fem_regions::<3, _>(scene, h, HexElement::Hex8),
+        (3, Method::FEM_HEX20) => fem_regions::<3, _>(scene, h, HexElement::Hex20),
+        _ => Ok(()),
+    }
+}
+
+/// The mesh of `element` builds and every region holds one of its nodes.
+fn fem_regions<const D: usize, E: ElementFamily<D>>(
+    scene: &Scene,
+    h: f64,
+    element: E,
+) -> Result<(), InputError> {
+    let mesh = body_mesh::<D, E>(scene, h, element)?;
+    region_dofs(scene, h, &|f| visit(&mesh, f)).map(|_| ())
+}
