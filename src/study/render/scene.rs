@@ -26,7 +26,10 @@ fn figures(r: &SceneResults) -> Vec<(String, String, Figure)> {
             }
             if m.history {
                 out.push((
-                    format!("{}: {} over the load steps", s.title, m.name),
+                    format!(
+                        "{}: {} over the load steps, finest case of each method",
+                        s.title, m.name
+                    ),
                     format!("{}-{}-history", s.id, m.name),
                     Figure::History(s.id.clone(), m.name.clone()),
                 ));
@@ -65,38 +68,55 @@ fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, Str
             convergence_svg_along(title, "1 / h", "relative error", &series, true).map(Some)
         }
         Figure::History(sweep, measure) => {
-            let mut series = vec![];
+            let steps = r
+                .study
+                .sweeps
+                .iter()
+                .find(|s| &s.id == sweep)
+                .and_then(|s| s.load_steps)
+                .unwrap_or(r.study.load_steps)
+                .max(1) as f64;
+            // The finest case of each method and points per cell: a legend of every case
+            // would not fit beside the curves.
+            let mut finest: Vec<&crate::study::scene::SceneRecord> = vec![];
             for c in r.sweep(sweep) {
-                let Some(h) = c.histories.get(measure) else {
+                if !c.histories.contains_key(measure) {
                     continue;
-                };
-                let n = h.len() as f64;
-                series.push(XySeries {
+                }
+                match finest
+                    .iter_mut()
+                    .find(|f| f.method == c.method && f.points_per_cell == c.points_per_cell)
+                {
+                    Some(f) if c.h < f.h => *f = c,
+                    Some(_) => {}
+                    None => finest.push(c),
+                }
+            }
+            // After step k of the sweep's load steps (a failed case stops early).
+            let along = |h: &[f64]| -> Vec<(f64, f64)> {
+                h.iter()
+                    .enumerate()
+                    .map(|(k, &v)| ((k + 1) as f64 / steps, v))
+                    .collect()
+            };
+            let mut series: Vec<XySeries> = finest
+                .iter()
+                .map(|c| XySeries {
                     label: c.id.clone(),
-                    points: h
-                        .iter()
-                        .enumerate()
-                        .map(|(k, &v)| ((k + 1) as f64 / n, v))
-                        .collect(),
+                    points: along(&c.histories[measure]),
                     line: true,
                     markers: true,
-                });
-            }
+                })
+                .collect();
             if let Some(reference) = r
                 .measures
                 .references
                 .get(measure)
                 .filter(|x| !x.history.is_empty())
             {
-                let n = reference.history.len() as f64;
                 series.push(XySeries {
                     label: "reference".into(),
-                    points: reference
-                        .history
-                        .iter()
-                        .enumerate()
-                        .map(|(k, &v)| ((k + 1) as f64 / n, v))
-                        .collect(),
+                    points: along(&reference.history),
                     line: true,
                     markers: false,
                 });
