@@ -52,7 +52,7 @@ PY
         fi
         # igimp, both methods (the bench's own rows: phases by name)
         for basis in mpm igimp; do
-            BASIS=$basis REPEATS=1 RAYON_NUM_THREADS=1 "$bench" "$n" | tail -1 | python3 -c "
+            BASIS=$basis REPEATS=1 RAYON_NUM_THREADS=1 "$bench" "$n" | grep "^compaction," | tail -1 | python3 -c "
 import sys
 f = sys.stdin.read().strip().split(',', 13)
 print(f'igimp,{f[1]},1/$n,{f[4]},{f[5]},{f[6]},,\"{f[13] if len(f) > 13 else \"\"}\"')" | tee -a "$csv"

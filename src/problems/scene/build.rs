@@ -3,14 +3,14 @@
 //! (a box as a structured mesh, a quadrilateral as a mapped one), and the checks of a
 //! resolution before anything is built.
 
-use super::geometry::{bilinear, clip_square, mapped_cells, Shape};
-use super::solve::{cells, region_dofs, SceneSettings};
-use super::spec::Scene;
+use super::geometry::{bilinear, clip_square, mapped_cells};
+use super::spec::{axis_index, region, LoadKind, Region, Scene, SceneSettings, Shape};
 use crate::basis::method::Method;
 use crate::fem::{ElementFamily, ElementMesh, HexElement, QuadElement};
 use crate::mesh::grid::Grid;
 use crate::mpm::particles::MaterialPoints;
 use crate::solver::error::{require_positive, InputError};
+use crate::solver::ramp::Ramp;
 use nalgebra::SVector;
 
 fn fixed_array<const D: usize>(v: &[f64]) -> [f64; D] {
@@ -213,4 +213,86 @@ fn fem_regions<const D: usize, E: ElementFamily<D>>(
 ) -> Result<(), InputError> {
     let mesh = body_mesh::<D, E>(scene, h, element)?;
     region_dofs(scene, h, &|f| visit(&mesh, f)).map(|_| ())
+}
+
+/// Cells of `length` at `h`, which must divide it.
+pub(super) fn cells(key: &str, length: f64, h: f64) -> Result<usize, InputError> {
+    let n = length / h;
+    if !(n.is_finite()
+        && (n - n.round()).abs() <= 1e-9 * n.max(1.0)
+        && n.round() >= 1.0
+        && n.round() <= 100_000.0)
+    {
+        return Err(InputError::new(
+            key,
+            length,
+            format!("must be a whole multiple (1 to 100000) of the element size {h}"),
+        ));
+    }
+    Ok(n.round() as usize)
+}
+
+/// Calls its argument with every node and its position.
+pub(super) type NodeVisitor<'a> = &'a dyn Fn(&mut dyn FnMut(usize, &[f64]));
+
+pub(super) type NamedDofs = Vec<(
+    String,
+    Vec<(usize, usize)>,
+    Option<(Vec<(usize, usize, f64)>, Ramp)>,
+)>;
+
+pub(super) fn region_dofs(
+    scene: &Scene,
+    h: f64,
+    positions: NodeVisitor<'_>,
+) -> Result<NamedDofs, InputError> {
+    let tol = 1e-9 * h;
+    let d = scene.dimension;
+    let nodes_in = |key: &str, r: Region<'_>| -> Result<Vec<usize>, InputError> {
+        let mut found = vec![];
+        positions(&mut |n, x| {
+            if r.holds(x, tol) {
+                found.push(n)
+            }
+        });
+        if found.is_empty() {
+            return Err(InputError::new(
+                key,
+                "no node",
+                format!("must hold at least one node at h = {h}"),
+            ));
+        }
+        Ok(found)
+    };
+    let mut out = vec![];
+    for (i, s) in scene.supports.iter().enumerate() {
+        let key = format!("supports[{i}]");
+        let nodes = nodes_in(&key, region(&key, &s.plane, &s.bounds, d)?)?;
+        let mut dofs = vec![];
+        for (j, c) in s.fix.iter().enumerate() {
+            let a = axis_index(&format!("{key}.fix[{j}]"), c, d)?;
+            dofs.extend(nodes.iter().map(|&n| (n, a)));
+        }
+        out.push((s.name.clone(), dofs, None));
+    }
+    for (i, l) in scene.loads.iter().enumerate() {
+        if l.kind != LoadKind::Displacement {
+            continue;
+        }
+        let key = format!("loads[{i}]");
+        let nodes = nodes_in(&key, region(&key, &l.plane, &l.bounds, d)?)?;
+        let given = l.displacement.as_ref().map(|c| c.given()).unwrap_or_default();
+        let mut dofs = vec![];
+        let mut values = vec![];
+        for &(a, v) in &given {
+            dofs.extend(nodes.iter().map(|&n| (n, a)));
+            values.extend(nodes.iter().map(|&n| (n, a, v)));
+        }
+        out.push((
+            l.name.clone().unwrap_or_default(),
+            dofs,
+            Some((values, l.ramp.clone())),
+        ));
+    }
+    Ok(out)
 }

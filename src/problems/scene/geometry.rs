@@ -3,65 +3,16 @@
 //! cell inside a polygon (Sutherland–Hodgman clipping, for points with volumes cut to the
 //! body) and the bilinear map of a quadrilateral (its mapped FEM mesh).
 
-use super::spec::{err, Body, Bounds};
 use crate::solver::error::{shortest, InputError};
 
-/// A body's shape.
-#[derive(Debug, Clone, Copy)]
-pub enum Shape<'a> {
-    Box(&'a Bounds),
-    /// Counter-clockwise or clockwise vertices, convex (checked).
-    Polygon(&'a [[f64; 2]]),
+fn err(key: impl Into<String>, value: impl ToString, allowed: impl Into<String>) -> InputError {
+    InputError::new(key, value, allowed)
 }
 
-impl Body {
-    /// The body's shape (validation makes exactly one of `box` and `polygon` present).
-    pub fn shape(&self) -> Shape<'_> {
-        match (&self.bounds, &self.polygon) {
-            (Some(b), _) => Shape::Box(b),
-            (None, Some(p)) => Shape::Polygon(p),
-            (None, None) => unreachable!("a validated body has a box or a polygon"),
-        }
-    }
-
-    /// The smallest box holding the body.
-    pub fn bounding_box(&self) -> Bounds {
-        match self.shape() {
-            Shape::Box(b) => b.clone(),
-            Shape::Polygon(p) => Bounds {
-                min: (0..2)
-                    .map(|a| p.iter().map(|v| v[a]).fold(f64::INFINITY, f64::min))
-                    .collect(),
-                max: (0..2)
-                    .map(|a| p.iter().map(|v| v[a]).fold(f64::NEG_INFINITY, f64::max))
-                    .collect(),
-            },
-        }
-    }
-
-    /// Does the body hold `x` (within `tol`)?
-    pub fn contains(&self, x: &[f64], tol: f64) -> bool {
-        match self.shape() {
-            Shape::Box(b) => b.contains(x, tol),
-            Shape::Polygon(p) => {
-                let s = orientation(p);
-                (0..p.len()).all(|i| s * cross(p[i], p[(i + 1) % p.len()], [x[0], x[1]]) >= -tol * edge(p, i))
-            }
-        }
-    }
-
-    /// The body's outline as a convex polygon (2D).
-    pub fn outline(&self) -> Vec<[f64; 2]> {
-        match self.shape() {
-            Shape::Polygon(p) => p.to_vec(),
-            Shape::Box(b) => vec![
-                [b.min[0], b.min[1]],
-                [b.max[0], b.min[1]],
-                [b.max[0], b.max[1]],
-                [b.min[0], b.max[1]],
-            ],
-        }
-    }
+/// Does the convex polygon `p` hold `x` (within `tol`, relative to its edges' lengths)?
+pub fn polygon_contains(p: &[[f64; 2]], x: &[f64], tol: f64) -> bool {
+    let s = orientation(p);
+    (0..p.len()).all(|i| s * cross(p[i], p[(i + 1) % p.len()], [x[0], x[1]]) >= -tol * edge(p, i))
 }
 
 fn cross(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {

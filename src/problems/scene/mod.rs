@@ -12,8 +12,8 @@ mod validate;
 
 pub use build::check_resolution;
 pub use closed_form::Platen;
-pub use solve::{methods, solve, MeasureValue, PointRecord, SceneOutcome, SceneSettings};
+pub use solve::{methods, solve, MeasureValue, PointRecord, SceneOutcome};
 pub use spec::{
     axis_index, region, Body, Bounds, ClosedForm, Components, GridSection, Load, LoadKind, Measure,
-    MeasureKind, Plane, Reference, Region, Scene, Support, AXES,
+    MeasureKind, Plane, Reference, Region, Scene, SceneSettings, Shape, Support, AXES,
 };

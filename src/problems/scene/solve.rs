@@ -2,10 +2,10 @@
 //! supports and displacement loads turned into node dofs, gravity and the ramps applied, the
 //! load steps run, and the measures read after every step.
 
-use super::spec::{axis_index, region, LoadKind, MeasureKind, Region, Scene};
+use super::build::{body_mesh, cells, fill_points, region_dofs, NamedDofs};
+use super::spec::{axis_index, LoadKind, MeasureKind, Scene, SceneSettings};
 use crate::basis::method::Method;
-use crate::basis::{Basis, DomainUpdate};
-use crate::discretise::ghost::GhostSettings;
+use crate::basis::Basis;
 use crate::fem::{ContinuumFem, ElementFamily, FemLoads, HexElement, PlaneFemSettings, QuadElement};
 use crate::material::kinematics::PointState;
 use crate::mesh::grid::Grid;
@@ -14,25 +14,9 @@ use crate::solver::dynamics::BodyForce;
 use crate::solver::error::{InputError, SolveError};
 use crate::solver::linear::LinearSolver;
 use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
-use crate::solver::newton::NewtonSettings;
 use crate::solver::ramp::Ramp;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
-
-/// How one case solves a scene besides its method.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SceneSettings {
-    /// Element size h: the grid's cells (cubes of h) and the FEM mesh's elements.
-    pub element_size: f64,
-    /// Material points per cell along each axis (material point methods).
-    pub points_per_cell: usize,
-    pub load_steps: usize,
-    pub newton: NewtonSettings,
-    pub ghost: GhostSettings,
-    pub domain_update: DomainUpdate,
-    pub linear_solver: LinearSolver,
-}
 
 /// One measure of a solved case: its final value and, if asked, its value after every step.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -88,97 +72,12 @@ pub fn solve(scene: &Scene, settings: &SceneSettings, method: Method) -> Result<
     }
 }
 
-/// Cells of `length` at `h`, which must divide it.
-pub(super) fn cells(key: &str, length: f64, h: f64) -> Result<usize, InputError> {
-    let n = length / h;
-    if !(n.is_finite()
-        && (n - n.round()).abs() <= 1e-9 * n.max(1.0)
-        && n.round() >= 1.0
-        && n.round() <= 100_000.0)
-    {
-        return Err(InputError::new(
-            key,
-            length,
-            format!("must be a whole multiple (1 to 100000) of the element size {h}"),
-        ));
-    }
-    Ok(n.round() as usize)
-}
-
 fn fixed_array<const D: usize>(v: &[f64]) -> [f64; D] {
     std::array::from_fn(|a| v[a])
 }
 
 /// The node dofs (node, axis, value) of every support (value 0) and displacement load, by
 /// the name of its region, from the nodes' positions: an error names a region on no node.
-/// Calls its argument with every node and its position.
-pub(super) type NodeVisitor<'a> = &'a dyn Fn(&mut dyn FnMut(usize, &[f64]));
-
-/// The reaction component `axis` summed over the (node, axis) dofs of a region.
-type ReactionSum<'a> = &'a dyn Fn(&[(usize, usize)], usize) -> f64;
-
-pub(super) type NamedDofs = Vec<(
-    String,
-    Vec<(usize, usize)>,
-    Option<(Vec<(usize, usize, f64)>, Ramp)>,
-)>;
-
-pub(super) fn region_dofs(
-    scene: &Scene,
-    h: f64,
-    positions: NodeVisitor<'_>,
-) -> Result<NamedDofs, InputError> {
-    let tol = 1e-9 * h;
-    let d = scene.dimension;
-    let nodes_in = |key: &str, r: Region<'_>| -> Result<Vec<usize>, InputError> {
-        let mut found = vec![];
-        positions(&mut |n, x| {
-            if r.holds(x, tol) {
-                found.push(n)
-            }
-        });
-        if found.is_empty() {
-            return Err(InputError::new(
-                key,
-                "no node",
-                format!("must hold at least one node at h = {h}"),
-            ));
-        }
-        Ok(found)
-    };
-    let mut out = vec![];
-    for (i, s) in scene.supports.iter().enumerate() {
-        let key = format!("supports[{i}]");
-        let nodes = nodes_in(&key, region(&key, &s.plane, &s.bounds, d)?)?;
-        let mut dofs = vec![];
-        for (j, c) in s.fix.iter().enumerate() {
-            let a = axis_index(&format!("{key}.fix[{j}]"), c, d)?;
-            dofs.extend(nodes.iter().map(|&n| (n, a)));
-        }
-        out.push((s.name.clone(), dofs, None));
-    }
-    for (i, l) in scene.loads.iter().enumerate() {
-        if l.kind != LoadKind::Displacement {
-            continue;
-        }
-        let key = format!("loads[{i}]");
-        let nodes = nodes_in(&key, region(&key, &l.plane, &l.bounds, d)?)?;
-        let given = l.displacement.as_ref().map(|c| c.given()).unwrap_or_default();
-        let mut dofs = vec![];
-        let mut values = vec![];
-        for &(a, v) in &given {
-            dofs.extend(nodes.iter().map(|&n| (n, a)));
-            values.extend(nodes.iter().map(|&n| (n, a, v)));
-        }
-        out.push((
-            l.name.clone().unwrap_or_default(),
-            dofs,
-            Some((values, l.ramp.clone())),
-        ));
-    }
-    Ok(out)
-}
-
 /// Σ of the gravity loads with a linear ramp, and those with a table.
 fn gravity<const D: usize>(scene: &Scene) -> (SVector<f64, D>, Vec<(SVector<f64, D>, Ramp)>) {
     let mut linear = SVector::<f64, D>::zeros();
@@ -218,6 +117,9 @@ fn energy(state: &PointState, volume0: f64, young: f64, poisson: f64) -> f64 {
     let e = &state.material.eps_e;
     volume0 * (mu * e.component_mul(e).sum() + 0.5 * lambda * e.trace().powi(2))
 }
+
+/// The reaction component `axis` summed over the (node, axis) dofs of a region.
+type ReactionSum<'a> = &'a dyn Fn(&[(usize, usize)], usize) -> f64;
 
 /// What the measures read from a solver.
 struct Probe<'a> {
@@ -319,7 +221,7 @@ fn solve_mpm<const D: usize>(
         n[a] = cells(&format!("grid.extent[{a}]"), scene.grid.extent[a], h)?;
     }
     let grid = Grid::try_new(fixed_array::<D>(&scene.grid.origin), [h; D], n)?;
-    let points = super::build::fill_points(scene, &grid, s.points_per_cell)?;
+    let points = fill_points(scene, &grid, s.points_per_cell)?;
     let named = region_dofs(scene, h, &|f| {
         for k in 0..grid.num_nodes() {
             f(k, grid.node_position(k).as_slice())
@@ -426,7 +328,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     element: E,
 ) -> Result<SceneOutcome, InputError> {
     let h = s.element_size;
-    let mesh = super::build::body_mesh::<D, E>(scene, h, element)?;
+    let mesh = body_mesh::<D, E>(scene, h, element)?;
     let body = &scene.bodies[0];
     let named = region_dofs(scene, h, &|f| {
         for (k, x) in mesh.nodes.iter().enumerate() {

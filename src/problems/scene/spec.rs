@@ -3,8 +3,12 @@
 //! (`bodies[1].box.max[0]`). The study file's `problem = "scene"` sections deserialise into
 //! these types (`studies/README.md`, "Scenes").
 
+use crate::basis::DomainUpdate;
+use crate::discretise::ghost::GhostSettings;
 use crate::material::constitutive::Material;
 use crate::solver::error::{shortest, InputError};
+use crate::solver::linear::LinearSolver;
+use crate::solver::newton::NewtonSettings;
 use crate::solver::ramp::Ramp;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -61,6 +65,61 @@ pub struct Body {
 
 fn one() -> f64 {
     1.0
+}
+
+/// A body's shape.
+#[derive(Debug, Clone, Copy)]
+pub enum Shape<'a> {
+    Box(&'a Bounds),
+    /// Counter-clockwise or clockwise vertices, convex (checked).
+    Polygon(&'a [[f64; 2]]),
+}
+
+impl Body {
+    /// The body's shape (validation makes exactly one of `box` and `polygon` present).
+    pub fn shape(&self) -> Shape<'_> {
+        match (&self.bounds, &self.polygon) {
+            (Some(b), _) => Shape::Box(b),
+            (None, Some(p)) => Shape::Polygon(p),
+            (None, None) => unreachable!("a validated body has a box or a polygon"),
+        }
+    }
+
+    /// The smallest box holding the body.
+    pub fn bounding_box(&self) -> Bounds {
+        match self.shape() {
+            Shape::Box(b) => b.clone(),
+            Shape::Polygon(p) => Bounds {
+                min: (0..2)
+                    .map(|a| p.iter().map(|v| v[a]).fold(f64::INFINITY, f64::min))
+                    .collect(),
+                max: (0..2)
+                    .map(|a| p.iter().map(|v| v[a]).fold(f64::NEG_INFINITY, f64::max))
+                    .collect(),
+            },
+        }
+    }
+
+    /// Does the body hold `x` (within `tol`)?
+    pub fn contains(&self, x: &[f64], tol: f64) -> bool {
+        match self.shape() {
+            Shape::Box(b) => b.contains(x, tol),
+            Shape::Polygon(p) => super::geometry::polygon_contains(p, x, tol),
+        }
+    }
+
+    /// The body's outline as a convex polygon (2D).
+    pub fn outline(&self) -> Vec<[f64; 2]> {
+        match self.shape() {
+            Shape::Polygon(p) => p.to_vec(),
+            Shape::Box(b) => vec![
+                [b.min[0], b.min[1]],
+                [b.max[0], b.min[1]],
+                [b.max[0], b.max[1]],
+                [b.min[0], b.max[1]],
+            ],
+        }
+    }
 }
 
 /// Grid (or mesh) nodes on a plane or in a box with some of their components fixed at zero.
@@ -493,4 +552,19 @@ impl Scene {
         }
         Ok(axes)
     }
+}
+
+/// How one case solves a scene besides its method.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSettings {
+    /// Element size h: the grid's cells (cubes of h) and the FEM mesh's elements.
+    pub element_size: f64,
+    /// Material points per cell along each axis (material point methods).
+    pub points_per_cell: usize,
+    pub load_steps: usize,
+    pub newton: NewtonSettings,
+    pub ghost: GhostSettings,
+    pub domain_update: DomainUpdate,
+    pub linear_solver: LinearSolver,
 }
