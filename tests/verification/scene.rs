@@ -288,3 +288,68 @@ measures = [{ name = "weight", kind = "reaction", region = "base", component = "
         assert!((w - 10.0 * area).abs() <= 1e-8 * area, "{method}: {w}");
     }
 }
+
+/// A uniform traction on a block's top face: every family and element carries the applied
+/// resultant to the base to round-off (equilibrium), and FEM, whose nodal forces are the
+/// consistent ones, reaches the homogeneous Hencky state (the platen's closed form read
+/// backwards: the dead force t A₀ = τ A₀ / λ).
+#[test]
+fn a_traction_is_carried_to_the_supports() {
+    let text = r#"
+grid = { origin = [0.0, 0.0], extent = [3.0, 2.0] }
+bodies = [{ name = "block", box = { min = [0.0, 0.0], max = [2.0, 2.0] }, material = "m" }]
+supports = [
+  { name = "left", plane = { axis = "x", at = 0.0 }, fix = ["x"] },
+  { name = "base", plane = { axis = "y", at = 0.0 }, fix = ["y"] },
+]
+loads = [{ kind = "traction", body = "block", face = "y+", vector = [0.0, -2000.0] }]
+measures = [
+  { name = "base", kind = "reaction", region = "base", component = "y" },
+  { name = "top", kind = "displacement", at = [1.0, 2.0], component = "y", domain_edge = true },
+]
+"#;
+    let (young, poisson) = (1e5, 0.3);
+    let s = scene(2, text, Material::linear_elastic(young, poisson));
+    // The stretch λ with E/(1 − ν²) ln λ / λ = t (plane strain, dead load per initial area).
+    let t = -2000.0;
+    let (mut lo, mut hi) = (0.5, 1.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if young / (1.0 - poisson * poisson) * f64::ln(mid) / mid < t {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let settle = (0.5 * (lo + hi) - 1.0) * 2.0;
+    for &method in scene::methods(2) {
+        let settings = SceneSettings {
+            element_size: 0.5,
+            points_per_cell: 2,
+            load_steps: 2,
+            newton: NewtonSettings {
+                tolerance: 1e-12,
+                ..Default::default()
+            },
+            ghost: GhostSettings {
+                gamma: 0.0,
+                faces: GhostFaces::Cut,
+                ..Default::default()
+            },
+            domain_update: Default::default(),
+            linear_solver: Default::default(),
+        };
+        let o = scene::solve(&s, &settings, method).unwrap();
+        assert!(o.failure.is_none(), "{method}: {:?}", o.failure);
+        // The base pushes up with the applied resultant, 2000 over the width 2.
+        let base = o.measures[0].value;
+        assert!((base - 4000.0).abs() <= 1e-9 * 4000.0, "{method}: base {base}");
+        let top = o.measures[1].value;
+        if method.is_fem() {
+            assert!(
+                (top - settle).abs() <= 1e-10 * settle.abs(),
+                "{method}: {top} against {settle}"
+            );
+        }
+    }
+}

@@ -296,3 +296,92 @@ pub(super) fn region_dofs(
     }
     Ok(out)
 }
+
+/// (axis, side, the face's coordinate, traction vector) of every traction of the scene, with
+/// the loaded body's index.
+fn tractions(scene: &Scene) -> Vec<(usize, usize, f64, f64, Vec<f64>)> {
+    scene
+        .loads
+        .iter()
+        .filter(|l| l.kind == LoadKind::Traction)
+        .filter_map(|l| {
+            let b = scene
+                .bodies
+                .iter()
+                .position(|b| Some(&b.name) == l.body.as_ref())?;
+            let (axis, side) = super::spec::face_of("", l.face.as_deref()?, scene.dimension).ok()?;
+            let bx = scene.bodies[b].bounding_box();
+            let at = if side > 0.0 { bx.max[axis] } else { bx.min[axis] };
+            Some((b, axis, side, at, l.vector.clone()?))
+        })
+        .collect()
+}
+
+/// The tractions as point loads: every point of the loaded body whose domain reaches the
+/// face carries the traction times its domain's share of the face.
+pub(super) fn traction_point_loads<const D: usize>(
+    scene: &Scene,
+    points: &MaterialPoints<D>,
+    h: f64,
+) -> Vec<(usize, SVector<f64, D>)> {
+    let mut loads = vec![];
+    for (b, axis, side, at, t) in tractions(scene) {
+        let body = &scene.bodies[b];
+        for p in 0..points.len() {
+            let (x, half) = (&points.position0[p], &points.half_length0[p]);
+            if !body.contains(x.as_slice(), 1e-9 * h) || (x[axis] + side * half[axis] - at).abs() > 1e-9 * h {
+                continue;
+            }
+            let area: f64 = (0..D).filter(|&a| a != axis).map(|a| 2.0 * half[a]).product();
+            loads.push((p, SVector::<f64, D>::from_iterator(t.iter().map(|v| v * area))));
+        }
+    }
+    loads
+}
+
+/// The tractions as consistent nodal forces: ∫ N_a t dA over the faces of the elements on the
+/// loaded face (a 3-point Gauss rule per face axis: exact for the faces of Q4/Q8 and
+/// Hex8/Hex20 of a box).
+pub(super) fn traction_nodal_forces<const D: usize, E: ElementFamily<D>>(
+    scene: &Scene,
+    mesh: &ElementMesh<D, E>,
+    h: f64,
+) -> Result<Vec<(usize, SVector<f64, D>)>, InputError> {
+    let rule = crate::mesh::quadrature::GaussRule::try_new(3)?;
+    let (xs, ws) = (rule.points(), rule.weights());
+    let mut forces = vec![];
+    for (_, axis, side, at, t) in tractions(scene) {
+        let t = SVector::<f64, D>::from_iterator(t.iter().copied());
+        for e in 0..mesh.num_elements() {
+            let ids = mesh.element_nodes(e);
+            let on_face: Vec<usize> = (0..ids.len())
+                .filter(|&k| mesh.element.local_node(k)[axis] == side)
+                .collect();
+            if !on_face
+                .iter()
+                .all(|&k| (mesh.nodes[ids[k]][axis] - at).abs() <= 1e-9 * h)
+            {
+                continue;
+            }
+            let others: Vec<usize> = (0..D).filter(|&a| a != axis).collect();
+            let count = xs.len().pow(others.len() as u32);
+            for q in 0..count {
+                let mut xi = SVector::<f64, D>::zeros();
+                xi[axis] = side;
+                let (mut r, mut w) = (q, 1.0);
+                for &a in &others {
+                    xi[a] = xs[r % xs.len()];
+                    w *= ws[r % xs.len()];
+                    r /= xs.len();
+                }
+                let (_, jac) = mesh.map(e, &xi);
+                let da: f64 = others.iter().map(|&a| jac[(a, a)].abs()).product();
+                let (n, _) = mesh.element.shape(&xi);
+                for &k in &on_face {
+                    forces.push((ids[k], t * (n[k] * w * da)));
+                }
+            }
+        }
+    }
+    Ok(forces)
+}

@@ -2,7 +2,9 @@
 //! supports and displacement loads turned into node dofs, gravity and the ramps applied, the
 //! load steps run, and the measures read after every step.
 
-use super::build::{body_mesh, cells, fill_points, region_dofs, NamedDofs};
+use super::build::{
+    body_mesh, cells, fill_points, region_dofs, traction_nodal_forces, traction_point_loads, NamedDofs,
+};
 use super::spec::{axis_index, LoadKind, MeasureKind, Scene, SceneSettings};
 use crate::basis::method::Method;
 use crate::basis::Basis;
@@ -248,7 +250,7 @@ fn solve_mpm<const D: usize>(
     let model = scene.materials[&scene.bodies[0].material].build()?;
     let loads = Loads {
         gravity: g,
-        point_loads: vec![],
+        point_loads: traction_point_loads(scene, &points, h),
     };
     let mut solver = MpmSolver::try_new(grid, points, model, fixed, loads, settings)?;
     if let Some(b) = tabled_body_force(scene, tabled) {
@@ -355,7 +357,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     let model = scene.materials[&body.material].build()?;
     let loads = FemLoads {
         gravity: g,
-        nodal_forces: vec![],
+        nodal_forces: traction_nodal_forces(scene, &mesh, h)?,
     };
     let mut fem = ContinuumFem::try_new(mesh, body.density, model, fixed, loads, settings)?;
     if let Some(b) = tabled_body_force(scene, tabled) {

@@ -145,6 +145,11 @@ pub enum LoadKind {
     /// components moved; the others stay free): a smooth platen moves one component, a rough
     /// one all.
     Displacement,
+    /// A uniform dead traction (`vector`, force per unit initial area, fixed in direction)
+    /// on one face of a box body (`body`, `face` = `x-`, `x+`, `y-`, …), reached linearly:
+    /// FEM takes the consistent nodal forces of the face's elements; material points carry
+    /// it as point loads, each the traction times its domain's share of the face.
+    Traction,
 }
 
 /// Prescribed displacement components (absent: free).
@@ -188,6 +193,11 @@ pub struct Load {
     /// Displacement: the prescribed components at full load.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub displacement: Option<Components>,
+    /// Traction: the loaded body and its face (`x-`, `x+`, `y-`, `y+`, `z-`, `z+`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub face: Option<String>,
     /// `"linear"` (default) or `{ table = [[0.0, 0.0], …, [1.0, f]] }`.
     #[serde(default, skip_serializing_if = "is_linear")]
     pub ramp: Ramp,
@@ -215,6 +225,28 @@ pub enum MeasureKind {
     /// axis: Σ_p |σ_p − σ(Z_p)| V₀_p / (ρ g V L) against σ(Z) = −ρ g (L − Z), Z the height above
     /// the base (reference/README.md item 66).
     ColumnStressError,
+}
+
+/// A face `x-`, `x+`, `y-`, … as (axis, +1 or −1).
+pub fn face_of(key: &str, face: &str, dimension: usize) -> Result<(usize, f64), InputError> {
+    let (axis, side) = face.split_at(face.len().min(1));
+    let a = AXES[..dimension].iter().position(|x| *x == axis);
+    match (a, side) {
+        (Some(a), "-") => Ok((a, -1.0)),
+        (Some(a), "+") => Ok((a, 1.0)),
+        _ => Err(err(
+            key,
+            format!("{face:?}"),
+            format!(
+                "must be one of {}",
+                AXES[..dimension]
+                    .iter()
+                    .flat_map(|x| [format!("{x}-"), format!("{x}+")])
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )),
+    }
 }
 
 /// The axis and magnitude of a scene's one gravity load when it has one box body and its

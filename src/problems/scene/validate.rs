@@ -21,19 +21,64 @@ impl Scene {
                 return Err(err(
                     format!("{key}.{field}"),
                     "given",
-                    format!(
-                        "is not a key of a {} load",
-                        if l.kind == LoadKind::Gravity {
-                            "gravity"
-                        } else {
-                            "displacement"
-                        }
-                    ),
+                    format!("is not a key of a {:?} load", l.kind),
                 ));
             }
             Ok(())
         };
+        if l.kind != LoadKind::Traction {
+            refuse("body", l.body.is_some())?;
+            refuse("face", l.face.is_some())?;
+        }
         match l.kind {
+            LoadKind::Traction => {
+                refuse("name", l.name.is_some())?;
+                refuse("plane", l.plane.is_some())?;
+                refuse("box", l.bounds.is_some())?;
+                refuse("displacement", l.displacement.is_some())?;
+                if l.ramp != crate::solver::ramp::Ramp::Linear {
+                    return Err(err(
+                        format!("{key}.ramp"),
+                        "a table",
+                        "must be \"linear\" for a traction (point and nodal loads grow with the load factor)",
+                    ));
+                }
+                let v = l.vector.as_ref().ok_or_else(|| {
+                    err(
+                        format!("{key}.vector"),
+                        "missing",
+                        "a traction needs its vector (force per unit area)",
+                    )
+                })?;
+                vector(&format!("{key}.vector"), v, d)?;
+                let name = l.body.as_ref().ok_or_else(|| {
+                    err(
+                        format!("{key}.body"),
+                        "missing",
+                        "a traction needs the body it loads",
+                    )
+                })?;
+                let body = self
+                    .bodies
+                    .iter()
+                    .find(|b| &b.name == name)
+                    .ok_or_else(|| err(format!("{key}.body"), format!("{name:?}"), "must name a body"))?;
+                if body.bounds.is_none() {
+                    return Err(err(
+                        format!("{key}.body"),
+                        format!("{name:?}"),
+                        "must be a box body (a traction loads one of its faces)",
+                    ));
+                }
+                let face = l.face.as_ref().ok_or_else(|| {
+                    err(
+                        format!("{key}.face"),
+                        "missing",
+                        "a traction needs a face, e.g. \"y+\"",
+                    )
+                })?;
+                super::spec::face_of(&format!("{key}.face"), face, d).map(|_| ())
+            }
             LoadKind::Gravity => {
                 refuse("name", l.name.is_some())?;
                 refuse("plane", l.plane.is_some())?;

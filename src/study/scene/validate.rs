@@ -41,7 +41,7 @@ impl SceneStudy {
         self.ghost
             .validate()
             .map_err(|e| chk.err(format!("ghost.{}", e.field), e.value, e.allowed))?;
-        let gravity = self.loads.iter().any(|l| l.kind == LoadKind::Gravity);
+        let gravity = self.loads.iter().any(|l| l.kind != LoadKind::Displacement);
         if !gravity && self.newton.residual_norm == ResidualNorm::External {
             return Err(chk.err(
                 "newton.residual_norm",
