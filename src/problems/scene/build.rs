@@ -182,27 +182,78 @@ pub fn check_resolution(scene: &Scene, s: &SceneSettings, method: Method) -> Res
                 })?;
             }
         }
-        let lattice = |f: &mut dyn FnMut(usize, &[f64])| {
-            let total: usize = n.iter().map(|c| c + 1).product();
-            let mut x = vec![0.0; d];
-            for k in 0..total {
-                let mut r = k;
-                for a in 0..d {
-                    x[a] = scene.grid.origin[a] + (r % (n[a] + 1)) as f64 * h;
-                    r /= n[a] + 1;
-                }
-                f(k, &x);
-            }
-        };
-        return region_dofs(scene, h, &lattice).map(|_| ());
+        let upper: Vec<f64> = (0..d)
+            .map(|a| scene.grid.origin[a] + scene.grid.extent[a])
+            .collect();
+        return lattice_regions(scene, &scene.grid.origin, &upper, h, h);
     }
-    match (d, method) {
-        (2, Method::FEM_Q4) => fem_regions::<2, _>(scene, h, QuadElement::Q4),
-        (2, Method::FEM_Q8) => fem_regions::<2, _>(scene, h, QuadElement::Q8),
-        (3, Method::FEM_HEX8) => fem_regions::<3, _>(scene, h, HexElement::Hex8),
-        (3, Method::FEM_HEX20) => fem_regions::<3, _>(scene, h, HexElement::Hex20),
+    let quadratic = matches!(method, Method::FEM_Q8 | Method::FEM_HEX20);
+    match (d, scene.bodies.first().map(|b| b.shape())) {
+        // A box's structured mesh: its nodes lie on the lattice of h (h / 2 with the
+        // mid-edge nodes) over the box, checked without building it (a 3D mesh at a fine h
+        // would cost a parse seconds).
+        (_, Some(Shape::Box(bx))) if scene.bodies.len() == 1 => {
+            for a in 0..d {
+                cells(&format!("bodies[0].box (axis {a})"), bx.max[a] - bx.min[a], h)?;
+            }
+            lattice_regions(scene, &bx.min, &bx.max, if quadratic { 0.5 * h } else { h }, h)
+        }
+        (2, _) if method == Method::FEM_Q4 => fem_regions::<2, _>(scene, h, QuadElement::Q4),
+        (2, _) if method == Method::FEM_Q8 => fem_regions::<2, _>(scene, h, QuadElement::Q8),
+        (3, _) if method == Method::FEM_HEX8 => fem_regions::<3, _>(scene, h, HexElement::Hex8),
+        (3, _) if method == Method::FEM_HEX20 => fem_regions::<3, _>(scene, h, HexElement::Hex20),
         _ => Ok(()),
     }
+}
+
+/// Every support and displacement load holds a node of the lattice of `spacing` over the box
+/// `[lower, upper]`: a plane on a lattice coordinate within the box, a box meeting one along
+/// every axis. The error is [`region_dofs`]'s.
+fn lattice_regions(
+    scene: &Scene,
+    lower: &[f64],
+    upper: &[f64],
+    spacing: f64,
+    h: f64,
+) -> Result<(), InputError> {
+    let d = scene.dimension;
+    let tol = 1e-9 * h;
+    // Is there a lattice coordinate along `a` in [lo, hi]?
+    let meets = |a: usize, lo: f64, hi: f64| {
+        let (lo, hi) = (lo.max(lower[a]), hi.min(upper[a]));
+        let first = ((lo - tol - lower[a]) / spacing).ceil();
+        let last = ((hi + tol - lower[a]) / spacing).floor();
+        first <= last
+    };
+    let check = |key: String, r: Region<'_>| -> Result<(), InputError> {
+        let held = match r {
+            Region::Plane(a, at) => meets(a, at, at) && (0..d).all(|b| b == a || lower[b] <= upper[b]),
+            Region::Box(b) => (0..d).all(|a| meets(a, b.min[a], b.max[a])),
+        };
+        if held {
+            Ok(())
+        } else {
+            Err(InputError::new(
+                key,
+                "no node",
+                format!("must hold at least one node at h = {h}"),
+            ))
+        }
+    };
+    for (i, s) in scene.supports.iter().enumerate() {
+        let key = format!("supports[{i}]");
+        check(key.clone(), region(&key, &s.plane, &s.bounds, d)?)?;
+    }
+    for (i, l) in scene
+        .loads
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.kind == LoadKind::Displacement)
+    {
+        let key = format!("loads[{i}]");
+        check(key.clone(), region(&key, &l.plane, &l.bounds, d)?)?;
+    }
+    Ok(())
 }
 
 /// The mesh of `element` builds and every region holds one of its nodes.
