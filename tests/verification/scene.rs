@@ -353,3 +353,55 @@ measures = [
         }
     }
 }
+
+/// A stress line through the smooth platen's homogeneous block reads the same σ_yy at every
+/// sample, the platen force over the current width, for every family and element.
+#[test]
+fn a_stress_line_reads_the_homogeneous_platen_stress() {
+    let text = r#"
+grid = { origin = [0.0, 0.0], extent = [3.0, 2.0] }
+bodies = [{ name = "block", box = { min = [0.0, 0.0], max = [2.0, 2.0] }, material = "m" }]
+supports = [
+  { name = "left", plane = { axis = "x", at = 0.0 }, fix = ["x"] },
+  { name = "base", plane = { axis = "y", at = 0.0 }, fix = ["y"] },
+]
+loads = [{ kind = "displacement", name = "platen", plane = { axis = "y", at = 2.0 }, displacement = { y = -0.04 } }]
+measures = [
+  { name = "force", kind = "reaction", region = "platen", component = "y" },
+  { name = "width", kind = "displacement", at = [2.0, 0.0], component = "x", domain_edge = true },
+  { name = "line", kind = "stress-line", at = [0.1, 0.1], to = [1.9, 1.8], samples = 7, component = "yy" },
+]
+"#;
+    let s = scene(2, text, Material::linear_elastic(1e5, 0.3));
+    for &method in scene::methods(2) {
+        let settings = SceneSettings {
+            element_size: 0.5,
+            points_per_cell: 2,
+            load_steps: 1,
+            newton: NewtonSettings {
+                residual_norm: ResidualNorm::Total,
+                tolerance: 1e-12,
+                ..Default::default()
+            },
+            ghost: GhostSettings {
+                gamma: 0.0,
+                faces: GhostFaces::Cut,
+                ..Default::default()
+            },
+            domain_update: Default::default(),
+            linear_solver: Default::default(),
+        };
+        let o = scene::solve(&s, &settings, method).unwrap();
+        assert!(o.failure.is_none(), "{method}: {:?}", o.failure);
+        let sigma = o.measures[0].value / (2.0 + o.measures[1].value);
+        let line = &o.measures[2].profile;
+        assert_eq!(line.len(), 7);
+        for v in line {
+            assert!(
+                (v - sigma).abs() <= 1e-10 * sigma.abs(),
+                "{method}: {v} against {sigma}"
+            );
+        }
+        assert!((o.measures[2].value - sigma).abs() <= 1e-10 * sigma.abs());
+    }
+}

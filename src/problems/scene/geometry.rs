@@ -5,6 +5,9 @@
 
 use crate::solver::error::{shortest, InputError};
 
+/// The axis names of a scene, in order.
+pub const AXES: [&str; 3] = ["x", "y", "z"];
+
 fn err(key: impl Into<String>, value: impl ToString, allowed: impl Into<String>) -> InputError {
     InputError::new(key, value, allowed)
 }

@@ -6,6 +6,7 @@
 mod build;
 mod closed_form;
 pub mod geometry;
+mod measures;
 mod solve;
 mod spec;
 mod validate;

@@ -27,6 +27,9 @@ pub struct MeasureValue {
     pub value: f64,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub history: Vec<f64>,
+    /// A stress line's samples at the end (its `value` is their mean).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub profile: Vec<f64>,
 }
 
 /// Final state of one material point or Gauss point (ParaView).
@@ -132,8 +135,40 @@ struct Probe<'a> {
     points: PointVisitor<'a>,
 }
 
-/// Calls its argument with each integration point's X₀, V₀ and state.
-type PointVisitor<'a> = &'a dyn Fn(&mut dyn FnMut(&[f64], f64, &PointState));
+/// Calls its argument with each integration point's X₀, current x, V₀ and state.
+type PointVisitor<'a> = &'a dyn Fn(PointSink<'_>);
+
+/// What a [`PointVisitor`] calls with X₀, x, V₀ and the state of each point.
+type PointSink<'a> = &'a mut dyn FnMut(&[f64], &[f64], f64, &PointState);
+
+/// The Cauchy stress component `m.component` (`xx`, `yy`, `xy`, …) along the segment from
+/// `m.at` to `m.to` in the current configuration, at `m.samples` equally spaced points: at
+/// each, the stress of the integration point whose current position is nearest.
+pub(super) fn stress_line(scene: &Scene, m: &super::spec::Measure, points: PointVisitor<'_>) -> Vec<f64> {
+    let (Some(a), Some(b), Some(c)) = (m.at.as_ref(), m.to.as_ref(), m.component.as_ref()) else {
+        return vec![];
+    };
+    let Some((i, j)) = super::measures::stress_component(c, scene.dimension) else {
+        return vec![];
+    };
+    let n = m.samples.unwrap_or(2).max(2);
+    let targets: Vec<Vec<f64>> = (0..n)
+        .map(|k| {
+            let t = k as f64 / (n - 1) as f64;
+            a.iter().zip(b).map(|(p, q)| p + t * (q - p)).collect()
+        })
+        .collect();
+    let mut best = vec![(f64::INFINITY, f64::NAN); n];
+    points(&mut |_, x, _, state| {
+        for (k, y) in targets.iter().enumerate() {
+            let d: f64 = x.iter().zip(y).map(|(u, v)| (u - v) * (u - v)).sum();
+            if d < best[k].0 {
+                best[k] = (d, state.cauchy()[(i, j)]);
+            }
+        }
+    });
+    best.into_iter().map(|b| b.1).collect()
+}
 
 /// Eq (46) of the column, for a body under one gravity load along an axis: Σ_p |σ_aa,p −
 /// σ(Z_p)| V₀_p / (ρ g V L) with σ(Z) = −ρ g (L − Z) (eq 42, equilibrium alone), Z the height
@@ -148,7 +183,7 @@ fn column_stress_error(scene: &Scene, points: PointVisitor<'_>) -> f64 {
     let (base, length) = (bb.min[axis], bb.max[axis] - bb.min[axis]);
     let unit_weight = body.density * g;
     let (mut sum, mut volume) = (0.0, 0.0);
-    points(&mut |x0, v0, state| {
+    points(&mut |x0, _, v0, state| {
         let exact = -unit_weight * (length - (x0[axis] - base));
         sum += (state.cauchy()[(axis, axis)] - exact).abs() * v0;
         volume += v0;
@@ -181,17 +216,26 @@ fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>) -> Vec<f64
                 MeasureKind::StrainEnergy => {
                     let (e, nu) = scene.hencky_parameters("").unwrap_or((f64::NAN, f64::NAN));
                     let mut sum = 0.0;
-                    (probe.points)(&mut |_, v0, state| sum += energy(state, v0, e, nu));
+                    (probe.points)(&mut |_, _, v0, state| sum += energy(state, v0, e, nu));
                     sum
                 }
                 MeasureKind::ColumnStressError => column_stress_error(scene, probe.points),
+                MeasureKind::StressLine => {
+                    let profile = stress_line(scene, m, probe.points);
+                    profile.iter().sum::<f64>() / profile.len().max(1) as f64
+                }
             }
         })
         .collect()
 }
 
 /// The measures after the run: final values and the histories asked for.
-fn gather(scene: &Scene, history: Vec<Vec<f64>>, last: Vec<f64>) -> Vec<MeasureValue> {
+fn gather(
+    scene: &Scene,
+    history: Vec<Vec<f64>>,
+    last: Vec<f64>,
+    points: PointVisitor<'_>,
+) -> Vec<MeasureValue> {
     scene
         .measures
         .iter()
@@ -201,6 +245,11 @@ fn gather(scene: &Scene, history: Vec<Vec<f64>>, last: Vec<f64>) -> Vec<MeasureV
             value: last[k],
             history: if m.history {
                 history.iter().map(|h| h[k]).collect()
+            } else {
+                vec![]
+            },
+            profile: if m.kind == MeasureKind::StressLine {
+                stress_line(scene, m, points)
             } else {
                 vec![]
             },
@@ -286,9 +335,14 @@ fn solve_mpm<const D: usize>(
                 .map(|&(n, a)| solver.reaction(n, a))
                 .sum()
         };
-        let points = |f: &mut dyn FnMut(&[f64], f64, &PointState)| {
+        let points = |f: PointSink<'_>| {
             for p in 0..pts.len() {
-                f(pts.position0[p].as_slice(), pts.volume0[p], &pts.state[p]);
+                f(
+                    pts.position0[p].as_slice(),
+                    pts.position[p].as_slice(),
+                    pts.volume0[p],
+                    &pts.state[p],
+                );
             }
         };
         read_measures(
@@ -306,6 +360,16 @@ fn solve_mpm<const D: usize>(
     let (steps, failure) = steps_and_failure(run);
     let last = measure(&solver);
     let pts = &solver.points;
+    let visit = |f: PointSink<'_>| {
+        for p in 0..pts.len() {
+            f(
+                pts.position0[p].as_slice(),
+                pts.position[p].as_slice(),
+                pts.volume0[p],
+                &pts.state[p],
+            );
+        }
+    };
     let points = (0..pts.len())
         .map(|p| PointRecord {
             x0: pad(&pts.position0[p]),
@@ -318,7 +382,7 @@ fn solve_mpm<const D: usize>(
     Ok(SceneOutcome {
         steps,
         failure,
-        measures: gather(scene, history, last),
+        measures: gather(scene, history, last, &visit),
         size: pts.len(),
         points,
     })
@@ -382,9 +446,10 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
                 .sum()
         };
         let g = &fem.gauss;
-        let points = |f: &mut dyn FnMut(&[f64], f64, &PointState)| {
+        let points = |f: PointSink<'_>| {
             for q in 0..g.len() {
-                f(g.position0[q].as_slice(), g.volume0[q], &g.state[q]);
+                let x = fem.gauss_point_position(q);
+                f(g.position0[q].as_slice(), x.as_slice(), g.volume0[q], &g.state[q]);
             }
         };
         read_measures(
@@ -401,10 +466,17 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     let run = fem.run_observed(&mut |fem, _| history.push(measure(fem)));
     let (steps, failure) = steps_and_failure(run);
     let last = measure(&fem);
+    let g = &fem.gauss;
+    let visit = |f: PointSink<'_>| {
+        for q in 0..g.len() {
+            let x = fem.gauss_point_position(q);
+            f(g.position0[q].as_slice(), x.as_slice(), g.volume0[q], &g.state[q]);
+        }
+    };
     Ok(SceneOutcome {
         steps,
         failure,
-        measures: gather(scene, history, last),
+        measures: gather(scene, history, last, &visit),
         size: fem.mesh.num_elements(),
         points: vec![],
     })

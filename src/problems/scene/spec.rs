@@ -13,8 +13,8 @@ use crate::solver::ramp::Ramp;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-/// The axis names of a scene, in order.
-pub const AXES: [&str; 3] = ["x", "y", "z"];
+pub use super::geometry::AXES;
+pub use super::measures::{ClosedForm, Measure, MeasureKind, Reference};
 
 /// The background grid: its lower corner and its extent along each axis. The element size h
 /// of a case divides every extent.
@@ -207,26 +207,6 @@ fn is_linear(r: &Ramp) -> bool {
     *r == Ramp::Linear
 }
 
-/// What a measure reads from a case.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum MeasureKind {
-    /// A displacement component of the material point whose initial position is nearest to
-    /// `at` (FEM: of the mesh node nearest to it); with `domain_edge`, of the point's domain
-    /// edge facing `at` (its displacement plus its half-length's growth).
-    Displacement,
-    /// The sum of one reaction component over a support's or a displacement load's nodes: the
-    /// force they exert on the body.
-    Reaction,
-    /// Σ V₀ W(εᵉ) over the points, W = μ εᵉ:εᵉ + λ/2 (tr εᵉ)² (Hencky; needs the material's
-    /// `young_modulus` and `poisson_ratio`).
-    StrainEnergy,
-    /// The column's stress error, eq (46), of a one-box scene under one gravity load along an
-    /// axis: Σ_p |σ_p − σ(Z_p)| V₀_p / (ρ g V L) against σ(Z) = −ρ g (L − Z), Z the height above
-    /// the base (reference/README.md item 66).
-    ColumnStressError,
-}
-
 /// A face `x-`, `x+`, `y-`, … as (axis, +1 or −1).
 pub fn face_of(key: &str, face: &str, dimension: usize) -> Result<(usize, f64), InputError> {
     let (axis, side) = face.split_at(face.len().min(1));
@@ -264,61 +244,6 @@ pub fn column_axis(scene: &Scene) -> Option<(usize, f64)> {
     let along: Vec<usize> = (0..g.len()).filter(|&a| g[a] != 0.0).collect();
     let [axis] = along[..] else { return None };
     (g[axis] < 0.0).then_some((axis, -g[axis]))
-}
-
-/// A closed form a measure is compared with.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum ClosedForm {
-    /// The smooth-platen force (reference/README.md item 65): τ_yy A₀ / λ along the platen's
-    /// axis, λ = 1 + δ / H.
-    PlatenForce,
-    /// The smooth-platen displacement (λ_i − 1)(at_i − min_i) of component i at `at`.
-    PlatenDisplacement,
-}
-
-/// The exact value a measure is compared with.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Reference {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub value: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub closed_form: Option<ClosedForm>,
-    /// Or the scene itself solved by the one FEM method of this sweep (of the study), its three
-    /// finest element sizes extrapolated (Richardson, with their grid convergence index).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub fem_sweep: Option<String>,
-    /// A closed form's body (its box and material) and displacement load (its platen).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub body: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub load: Option<String>,
-    /// Where the value or formula comes from.
-    pub source: String,
-}
-
-/// One named output of every case.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Measure {
-    pub name: String,
-    pub kind: MeasureKind,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub at: Option<Vec<f64>>,
-    /// `x`, `y` or `z` (displacement and reaction).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub component: Option<String>,
-    /// A reaction's support or displacement load, by name.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub region: Option<String>,
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub domain_edge: bool,
-    /// Also record the value after every load step.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub history: bool,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub reference: Option<Reference>,
 }
 
 /// A whole scene with its materials resolved.

@@ -158,6 +158,10 @@ impl Scene {
             }
             Ok(())
         };
+        if m.kind != MeasureKind::StressLine {
+            refuse("to", m.to.is_some())?;
+            refuse("samples", m.samples.is_some())?;
+        }
         match m.kind {
             MeasureKind::Displacement => {
                 refuse("region", m.region.is_some())?;
@@ -194,6 +198,52 @@ impl Scene {
                     ));
                 }
                 self.component(&key, m)?;
+            }
+            MeasureKind::StressLine => {
+                for (f, g) in [
+                    ("region", m.region.is_some()),
+                    ("domain_edge", m.domain_edge),
+                    ("history", m.history),
+                ] {
+                    refuse(f, g)?;
+                }
+                let at = m.at.as_ref().ok_or_else(|| {
+                    err(
+                        format!("{key}.at"),
+                        "missing",
+                        "a stress line needs its start `at`",
+                    )
+                })?;
+                vector(&format!("{key}.at"), at, d)?;
+                let to = m
+                    .to
+                    .as_ref()
+                    .ok_or_else(|| err(format!("{key}.to"), "missing", "a stress line needs its end `to`"))?;
+                vector(&format!("{key}.to"), to, d)?;
+                let n = m.samples.ok_or_else(|| {
+                    err(
+                        format!("{key}.samples"),
+                        "missing",
+                        "a stress line needs its number of samples",
+                    )
+                })?;
+                if !(2..=1000).contains(&n) {
+                    return Err(err(format!("{key}.samples"), n, "must be an integer in 2..=1000"));
+                }
+                let c = m.component.as_ref().ok_or_else(|| {
+                    err(
+                        format!("{key}.component"),
+                        "missing",
+                        "a stress line needs a component, e.g. \"yy\"",
+                    )
+                })?;
+                if super::measures::stress_component(c, d).is_none() {
+                    return Err(err(
+                        format!("{key}.component"),
+                        format!("{c:?}"),
+                        "must be a stress component: two of x, y, z (in 2D also zz), e.g. \"yy\", \"xy\"",
+                    ));
+                }
             }
             MeasureKind::ColumnStressError => {
                 for (f, g) in [

@@ -24,6 +24,16 @@ fn figures(r: &SceneResults) -> Vec<(String, String, Figure)> {
                     Figure::Error(s.id.clone(), m.name.clone()),
                 ));
             }
+            if r.cases.iter().any(|c| c.profiles.contains_key(&m.name)) {
+                out.push((
+                    format!(
+                        "{}: {} along its line, finest case of each method",
+                        s.title, m.name
+                    ),
+                    format!("{}-{}-profile", s.id, m.name),
+                    Figure::Profile(s.id.clone(), m.name.clone()),
+                ));
+            }
             if m.history {
                 out.push((
                     format!(
@@ -42,6 +52,31 @@ fn figures(r: &SceneResults) -> Vec<(String, String, Figure)> {
 enum Figure {
     Error(String, String),
     History(String, String),
+    Profile(String, String),
+}
+
+/// The finest case of each method and points per cell of `sweep` that has `has`: a legend
+/// of every case would not fit beside the curves.
+fn finest_cases<'a>(
+    r: &'a SceneResults,
+    sweep: &str,
+    has: impl Fn(&crate::study::scene::SceneRecord) -> bool,
+) -> Vec<&'a crate::study::scene::SceneRecord> {
+    let mut finest: Vec<&crate::study::scene::SceneRecord> = vec![];
+    for c in r.sweep(sweep) {
+        if !has(c) {
+            continue;
+        }
+        match finest
+            .iter_mut()
+            .find(|f| f.method == c.method && f.points_per_cell == c.points_per_cell)
+        {
+            Some(f) if c.h < f.h => *f = c,
+            Some(_) => {}
+            None => finest.push(c),
+        }
+    }
+    finest
 }
 
 fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, String> {
@@ -67,6 +102,33 @@ fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, Str
             }
             convergence_svg_along(title, "1 / h", "relative error", &series, true).map(Some)
         }
+        Figure::Profile(sweep, measure) => {
+            let series: Vec<XySeries> = finest_cases(r, sweep, |c| c.profiles.contains_key(measure))
+                .iter()
+                .map(|c| {
+                    let p = &c.profiles[measure];
+                    let n = (p.len().max(2) - 1) as f64;
+                    XySeries {
+                        label: c.id.clone(),
+                        points: p.iter().enumerate().map(|(k, &v)| (k as f64 / n, v)).collect(),
+                        line: true,
+                        markers: false,
+                    }
+                })
+                .collect();
+            if series.is_empty() {
+                return Ok(None);
+            }
+            let axes = XyAxes {
+                x_desc: "position along the line (fraction)".into(),
+                y_desc: measure.clone(),
+                log_x: false,
+                log_y: false,
+                y_lines: vec![],
+                legend: LegendCorner::LowerLeft,
+            };
+            xy_svg(title, &axes, &series).map(Some)
+        }
         Figure::History(sweep, measure) => {
             let steps = r
                 .study
@@ -76,22 +138,7 @@ fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, Str
                 .and_then(|s| s.load_steps)
                 .unwrap_or(r.study.load_steps)
                 .max(1) as f64;
-            // The finest case of each method and points per cell: a legend of every case
-            // would not fit beside the curves.
-            let mut finest: Vec<&crate::study::scene::SceneRecord> = vec![];
-            for c in r.sweep(sweep) {
-                if !c.histories.contains_key(measure) {
-                    continue;
-                }
-                match finest
-                    .iter_mut()
-                    .find(|f| f.method == c.method && f.points_per_cell == c.points_per_cell)
-                {
-                    Some(f) if c.h < f.h => *f = c,
-                    Some(_) => {}
-                    None => finest.push(c),
-                }
-            }
+            let finest = finest_cases(r, sweep, |c| c.histories.contains_key(measure));
             // After step k of the sweep's load steps (a failed case stops early).
             let along = |h: &[f64]| -> Vec<(f64, f64)> {
                 h.iter()

@@ -20,6 +20,7 @@ fn solve_case(scene: &Scene, case: &SceneCase) -> (SceneRecord, Vec<crate::probl
     };
     let mut measures = BTreeMap::new();
     let mut histories = BTreeMap::new();
+    let mut profiles = BTreeMap::new();
     if let Some(o) = &o {
         for m in &o.measures {
             if m.value.is_finite() && !o.steps.is_empty() {
@@ -27,6 +28,9 @@ fn solve_case(scene: &Scene, case: &SceneCase) -> (SceneRecord, Vec<crate::probl
             }
             if !m.history.is_empty() {
                 histories.insert(m.name.clone(), m.history.clone());
+            }
+            if !m.profile.is_empty() && !o.steps.is_empty() {
+                profiles.insert(m.name.clone(), m.profile.clone());
             }
         }
     }
@@ -41,6 +45,7 @@ fn solve_case(scene: &Scene, case: &SceneCase) -> (SceneRecord, Vec<crate::probl
         solve,
         measures,
         histories,
+        profiles,
         points: o.as_ref().map_or(0, |o| o.size),
     };
     (rec, o.map_or(vec![], |o| o.points))

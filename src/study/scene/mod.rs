@@ -145,6 +145,9 @@ pub struct SceneRecord {
     /// Value after each converged load step, for the history measures.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub histories: BTreeMap<String, Vec<f64>>,
+    /// The samples of each stress line at the end.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub profiles: BTreeMap<String, Vec<f64>>,
     /// Material points or elements.
     pub points: usize,
 }
