@@ -170,6 +170,27 @@ pub(super) fn stress_line(scene: &Scene, m: &super::spec::Measure, points: Point
     best.into_iter().map(|b| b.1).collect()
 }
 
+/// Every material point's X₀, x, V₀ and state, to `f`.
+fn visit_points<const D: usize>(pts: &crate::mpm::particles::MaterialPoints<D>, f: PointSink<'_>) {
+    for p in 0..pts.len() {
+        f(
+            pts.position0[p].as_slice(),
+            pts.position[p].as_slice(),
+            pts.volume0[p],
+            &pts.state[p],
+        );
+    }
+}
+
+/// Every Gauss point's X₀, x, V₀ and state, to `f`.
+fn visit_gauss<const D: usize, E: ElementFamily<D>>(fem: &ContinuumFem<D, E>, f: PointSink<'_>) {
+    let g = &fem.gauss;
+    for q in 0..g.len() {
+        let x = fem.gauss_point_position(q);
+        f(g.position0[q].as_slice(), x.as_slice(), g.volume0[q], &g.state[q]);
+    }
+}
+
 /// Eq (46) of the column, for a body under one gravity load along an axis: Σ_p |σ_aa,p −
 /// σ(Z_p)| V₀_p / (ρ g V L) with σ(Z) = −ρ g (L − Z) (eq 42, equilibrium alone), Z the height
 /// above the body's base along the gravity's axis a, L the body's height and V its volume;
@@ -335,16 +356,7 @@ fn solve_mpm<const D: usize>(
                 .map(|&(n, a)| solver.reaction(n, a))
                 .sum()
         };
-        let points = |f: PointSink<'_>| {
-            for p in 0..pts.len() {
-                f(
-                    pts.position0[p].as_slice(),
-                    pts.position[p].as_slice(),
-                    pts.volume0[p],
-                    &pts.state[p],
-                );
-            }
-        };
+        let points = |f: PointSink<'_>| visit_points(pts, f);
         read_measures(
             scene,
             &named,
@@ -360,16 +372,7 @@ fn solve_mpm<const D: usize>(
     let (steps, failure) = steps_and_failure(run);
     let last = measure(&solver);
     let pts = &solver.points;
-    let visit = |f: PointSink<'_>| {
-        for p in 0..pts.len() {
-            f(
-                pts.position0[p].as_slice(),
-                pts.position[p].as_slice(),
-                pts.volume0[p],
-                &pts.state[p],
-            );
-        }
-    };
+    let visit = |f: PointSink<'_>| visit_points(pts, f);
     let points = (0..pts.len())
         .map(|p| PointRecord {
             x0: pad(&pts.position0[p]),
@@ -445,13 +448,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
                 .map(|&(n, a)| fem.reaction(n, a))
                 .sum()
         };
-        let g = &fem.gauss;
-        let points = |f: PointSink<'_>| {
-            for q in 0..g.len() {
-                let x = fem.gauss_point_position(q);
-                f(g.position0[q].as_slice(), x.as_slice(), g.volume0[q], &g.state[q]);
-            }
-        };
+        let points = |f: PointSink<'_>| visit_gauss(fem, f);
         read_measures(
             scene,
             &named,
@@ -466,13 +463,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     let run = fem.run_observed(&mut |fem, _| history.push(measure(fem)));
     let (steps, failure) = steps_and_failure(run);
     let last = measure(&fem);
-    let g = &fem.gauss;
-    let visit = |f: PointSink<'_>| {
-        for q in 0..g.len() {
-            let x = fem.gauss_point_position(q);
-            f(g.position0[q].as_slice(), x.as_slice(), g.volume0[q], &g.state[q]);
-        }
-    };
+    let visit = |f: PointSink<'_>| visit_gauss(&fem, f);
     Ok(SceneOutcome {
         steps,
         failure,

@@ -79,6 +79,19 @@ fn finest_cases<'a>(
     finest
 }
 
+/// Curves of a measure on linear axes, the legend in the lower left.
+fn lines(title: &str, x_desc: &str, measure: &str, series: &[XySeries]) -> Result<Option<String>, String> {
+    let axes = XyAxes {
+        x_desc: x_desc.into(),
+        y_desc: measure.into(),
+        log_x: false,
+        log_y: false,
+        y_lines: vec![],
+        legend: LegendCorner::LowerLeft,
+    };
+    xy_svg(title, &axes, series).map(Some)
+}
+
 fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, String> {
     match f {
         Figure::Error(sweep, measure) => {
@@ -119,15 +132,7 @@ fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, Str
             if series.is_empty() {
                 return Ok(None);
             }
-            let axes = XyAxes {
-                x_desc: "position along the line (fraction)".into(),
-                y_desc: measure.clone(),
-                log_x: false,
-                log_y: false,
-                y_lines: vec![],
-                legend: LegendCorner::LowerLeft,
-            };
-            xy_svg(title, &axes, &series).map(Some)
+            lines(title, "position along the line (fraction)", measure, &series)
         }
         Figure::History(sweep, measure) => {
             let steps = r
@@ -171,15 +176,7 @@ fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, Str
             if series.is_empty() {
                 return Ok(None);
             }
-            let axes = XyAxes {
-                x_desc: "load fraction".into(),
-                y_desc: measure.clone(),
-                log_x: false,
-                log_y: false,
-                y_lines: vec![],
-                legend: LegendCorner::LowerLeft,
-            };
-            xy_svg(title, &axes, &series).map(Some)
+            lines(title, "load fraction", measure, &series)
         }
     }
 }
