@@ -73,6 +73,20 @@ use crate::solver::newton::NewtonSettings;
 use nalgebra::SVector;
 use updated_lagrangian::{fem_advance, fem_step_system, UlCore};
 
+/// The solver of a FEM comparator asked for `requested`: the iterative strategy if asked
+/// for, LDLᵀ otherwise (the symmetric factorisation the comparators' committed answers come
+/// from; their tangents are symmetric).
+pub fn comparator_solver(
+    requested: crate::solver::linear::LinearSolver,
+) -> crate::solver::linear::LinearSolver {
+    use crate::solver::linear::LinearSolver;
+    if requested == LinearSolver::Iterative {
+        LinearSolver::Iterative
+    } else {
+        LinearSolver::Ldlt
+    }
+}
+
 /// Settings of a [`LineFem`] analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LineFemSettings {

@@ -6,7 +6,6 @@ use crate::fem::{
     QuadElement,
 };
 use crate::solver::error::{InputError, SolveError};
-use crate::solver::linear::LinearSolver;
 use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
 use nalgebra::SVector;
 
@@ -76,11 +75,7 @@ fn fem_block<const D: usize, E: ElementFamily<D>>(
         load_steps: spec.load_steps,
         // LDLᵀ unless the spec asks for the iterative solver (its LU default is the material
         // point methods').
-        linear_solver: if spec.linear_solver == LinearSolver::Iterative {
-            LinearSolver::Iterative
-        } else {
-            LinearSolver::Ldlt
-        },
+        linear_solver: crate::fem::comparator_solver(spec.linear_solver),
     };
     let fem = ContinuumFem::try_new(mesh, 1.0, spec.model()?, fixed, loads, settings)?;
     Ok((fem, corner))

@@ -436,3 +436,19 @@ pub(super) fn traction_nodal_forces<const D: usize, E: ElementFamily<D>>(
     }
     Ok(forces)
 }
+
+/// The supports' fixed dofs (node, axis) of `named`.
+pub(super) fn fixed_dofs(named: &NamedDofs) -> Vec<(usize, usize)> {
+    named
+        .iter()
+        .filter(|n| n.2.is_none())
+        .flat_map(|n| n.1.iter().copied())
+        .collect()
+}
+
+/// The displacement loads of `named`: their (node, axis, value) and ramp.
+pub(super) fn prescribed(named: &NamedDofs) -> impl Iterator<Item = (&[(usize, usize, f64)], &Ramp)> {
+    named
+        .iter()
+        .filter_map(|n| n.2.as_ref().map(|(v, r)| (&v[..], r)))
+}

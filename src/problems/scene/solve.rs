@@ -3,7 +3,8 @@
 //! load steps run, and the measures read after every step.
 
 use super::build::{
-    body_mesh, cells, fill_points, region_dofs, traction_nodal_forces, traction_point_loads, NamedDofs,
+    body_mesh, cells, fill_points, fixed_dofs, prescribed, region_dofs, traction_nodal_forces,
+    traction_point_loads, NamedDofs,
 };
 use super::spec::{axis_index, LoadKind, MeasureKind, Scene, SceneSettings};
 use crate::basis::method::Method;
@@ -14,7 +15,6 @@ use crate::mesh::grid::Grid;
 use crate::mpm::{Loads, MpmSettings, MpmSolver};
 use crate::solver::dynamics::BodyForce;
 use crate::solver::error::{InputError, SolveError};
-use crate::solver::linear::LinearSolver;
 use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
 use crate::solver::ramp::Ramp;
 use nalgebra::SVector;
@@ -123,13 +123,11 @@ fn energy(state: &PointState, volume0: f64, young: f64, poisson: f64) -> f64 {
     volume0 * (mu * e.component_mul(e).sum() + 0.5 * lambda * e.trace().powi(2))
 }
 
-/// The reaction component `axis` summed over the (node, axis) dofs of a region.
-type ReactionSum<'a> = &'a dyn Fn(&[(usize, usize)], usize) -> f64;
-
 /// What the measures read from a solver.
 struct Probe<'a> {
     displacement: &'a dyn Fn(&[f64], usize, bool) -> f64,
-    reaction: ReactionSum<'a>,
+    /// The reaction at (node, axis).
+    reaction: &'a dyn Fn(usize, usize) -> f64,
     /// Calls its argument with every integration point's initial position, initial volume
     /// and committed state.
     points: PointVisitor<'a>,
@@ -212,8 +210,20 @@ fn column_stress_error(scene: &Scene, points: PointVisitor<'_>) -> f64 {
     sum / (unit_weight * volume * length)
 }
 
+/// One measure read after a step: its value and, for a stress line, its samples (the value
+/// is their mean).
+#[derive(Debug, Clone)]
+struct Reading {
+    value: f64,
+    profile: Vec<f64>,
+}
+
 /// Every measure of `scene` from `probe`, with the region dofs `named`.
-fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>) -> Vec<f64> {
+fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>) -> Vec<Reading> {
+    let value = |value: f64| Reading {
+        value,
+        profile: vec![],
+    };
     scene
         .measures
         .iter()
@@ -224,56 +234,65 @@ fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>) -> Vec<f64
                 .and_then(|c| axis_index("", c, scene.dimension).ok())
                 .unwrap_or(0);
             match m.kind {
-                MeasureKind::Displacement => {
-                    (probe.displacement)(m.at.as_deref().unwrap_or(&[]), axis, m.domain_edge)
-                }
+                MeasureKind::Displacement => value((probe.displacement)(
+                    m.at.as_deref().unwrap_or(&[]),
+                    axis,
+                    m.domain_edge,
+                )),
                 MeasureKind::Reaction => {
                     let dofs = named
                         .iter()
                         .find(|n| Some(&n.0) == m.region.as_ref())
                         .map_or(&[][..], |n| &n.1[..]);
-                    (probe.reaction)(dofs, axis)
+                    value(
+                        dofs.iter()
+                            .filter(|d| d.1 == axis)
+                            .map(|&(n, a)| (probe.reaction)(n, a))
+                            .sum(),
+                    )
                 }
                 MeasureKind::StrainEnergy => {
                     let (e, nu) = scene.hencky_parameters("").unwrap_or((f64::NAN, f64::NAN));
                     let mut sum = 0.0;
                     (probe.points)(&mut |_, _, v0, state| sum += energy(state, v0, e, nu));
-                    sum
+                    value(sum)
                 }
-                MeasureKind::ColumnStressError => column_stress_error(scene, probe.points),
+                MeasureKind::ColumnStressError => value(column_stress_error(scene, probe.points)),
                 MeasureKind::StressLine => {
                     let profile = stress_line(scene, m, probe.points);
-                    profile.iter().sum::<f64>() / profile.len().max(1) as f64
+                    Reading {
+                        value: profile.iter().sum::<f64>() / profile.len().max(1) as f64,
+                        profile,
+                    }
                 }
             }
         })
         .collect()
 }
 
-/// The measures after the run: final values and the histories asked for.
+/// The measures after the run, from the readings after each converged step: the final
+/// values (and stress-line samples) are the last step's, or `unloaded`'s when no step
+/// converged, never those of a failed attempt (its reactions would be the failed iterate's).
 fn gather(
     scene: &Scene,
-    history: Vec<Vec<f64>>,
-    last: Vec<f64>,
-    points: PointVisitor<'_>,
+    history: Vec<Vec<Reading>>,
+    unloaded: impl FnOnce() -> Vec<Reading>,
 ) -> Vec<MeasureValue> {
+    let last = history.last().cloned().unwrap_or_else(unloaded);
     scene
         .measures
         .iter()
+        .zip(last)
         .enumerate()
-        .map(|(k, m)| MeasureValue {
+        .map(|(k, (m, last))| MeasureValue {
             name: m.name.clone(),
-            value: last[k],
+            value: last.value,
             history: if m.history {
-                history.iter().map(|h| h[k]).collect()
+                history.iter().map(|h| h[k].value).collect()
             } else {
                 vec![]
             },
-            profile: if m.kind == MeasureKind::StressLine {
-                stress_line(scene, m, points)
-            } else {
-                vec![]
-            },
+            profile: last.profile,
         })
         .collect()
 }
@@ -300,11 +319,7 @@ fn solve_mpm<const D: usize>(
         }
     })?;
     let (g, tabled) = gravity::<D>(scene);
-    let fixed: Vec<(usize, usize)> = named
-        .iter()
-        .filter(|n| n.2.is_none())
-        .flat_map(|n| n.1.iter().copied())
-        .collect();
+    let fixed = fixed_dofs(&named);
     let settings = MpmSettings {
         basis,
         domain_update: s.domain_update,
@@ -326,10 +341,8 @@ fn solve_mpm<const D: usize>(
     if let Some(b) = tabled_body_force(scene, tabled) {
         solver.set_body_force(b);
     }
-    for (_, _, p) in &named {
-        if let Some((values, ramp)) = p {
-            solver.prescribe(values, ramp.clone())?;
-        }
+    for (values, ramp) in prescribed(&named) {
+        solver.prescribe(values, ramp.clone())?;
     }
     let measure = |solver: &MpmSolver<D>| {
         let pts = &solver.points;
@@ -350,12 +363,7 @@ fn solve_mpm<const D: usize>(
             };
             pts.displacement(p)[axis] + grow
         };
-        let reaction = |dofs: &[(usize, usize)], axis: usize| {
-            dofs.iter()
-                .filter(|d| d.1 == axis)
-                .map(|&(n, a)| solver.reaction(n, a))
-                .sum()
-        };
+        let reaction = |n: usize, a: usize| solver.reaction(n, a);
         let points = |f: PointSink<'_>| visit_points(pts, f);
         read_measures(
             scene,
@@ -370,9 +378,8 @@ fn solve_mpm<const D: usize>(
     let mut history = vec![];
     let run = solver.run_observed(&mut |solver, _| history.push(measure(solver)));
     let (steps, failure) = steps_and_failure(run);
-    let last = measure(&solver);
+    let measures = gather(scene, history, || measure(&solver));
     let pts = &solver.points;
-    let visit = |f: PointSink<'_>| visit_points(pts, f);
     let points = (0..pts.len())
         .map(|p| PointRecord {
             x0: pad(&pts.position0[p]),
@@ -385,7 +392,7 @@ fn solve_mpm<const D: usize>(
     Ok(SceneOutcome {
         steps,
         failure,
-        measures: gather(scene, history, last, &visit),
+        measures,
         size: pts.len(),
         points,
     })
@@ -405,21 +412,12 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
         }
     })?;
     let (g, tabled) = gravity::<D>(scene);
-    let fixed: Vec<(usize, usize)> = named
-        .iter()
-        .filter(|n| n.2.is_none())
-        .flat_map(|n| n.1.iter().copied())
-        .collect();
+    let fixed = fixed_dofs(&named);
     let settings = PlaneFemSettings {
         gauss_points: None,
         newton: s.newton,
         load_steps: s.load_steps,
-        // LDLᵀ, as the built-in problems' FEM (their results equal to the bit), unless CG is asked for.
-        linear_solver: if s.linear_solver == LinearSolver::Iterative {
-            LinearSolver::Iterative
-        } else {
-            LinearSolver::Ldlt
-        },
+        linear_solver: crate::fem::comparator_solver(s.linear_solver),
     };
     let model = scene.materials[&body.material].build()?;
     let loads = FemLoads {
@@ -430,10 +428,8 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     if let Some(b) = tabled_body_force(scene, tabled) {
         fem.set_body_force(b);
     }
-    for (_, _, p) in &named {
-        if let Some((values, ramp)) = p {
-            fem.prescribe(values, ramp.clone())?;
-        }
+    for (values, ramp) in prescribed(&named) {
+        fem.prescribe(values, ramp.clone())?;
     }
     let measure = |fem: &ContinuumFem<D, E>| {
         let displacement = |at: &[f64], axis: usize, _edge: bool| {
@@ -442,12 +438,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
                 .nearest_node(SVector::<f64, D>::from_iterator(at.iter().copied()));
             fem.displacement(node)[axis]
         };
-        let reaction = |dofs: &[(usize, usize)], axis: usize| {
-            dofs.iter()
-                .filter(|d| d.1 == axis)
-                .map(|&(n, a)| fem.reaction(n, a))
-                .sum()
-        };
+        let reaction = |n: usize, a: usize| fem.reaction(n, a);
         let points = |f: PointSink<'_>| visit_gauss(fem, f);
         read_measures(
             scene,
@@ -462,12 +453,10 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     let mut history = vec![];
     let run = fem.run_observed(&mut |fem, _| history.push(measure(fem)));
     let (steps, failure) = steps_and_failure(run);
-    let last = measure(&fem);
-    let visit = |f: PointSink<'_>| visit_gauss(&fem, f);
     Ok(SceneOutcome {
         steps,
         failure,
-        measures: gather(scene, history, last, &visit),
+        measures: gather(scene, history, || measure(&fem)),
         size: fem.mesh.num_elements(),
         points: vec![],
     })
