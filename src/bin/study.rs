@@ -32,8 +32,16 @@ static ALLOCATOR: igimp::solver::profile::CountingAllocator = igimp::solver::pro
 )]
 struct Cli {
     /// Study names (files `<studies>/<name>.toml`), paths to study files, `all`, or `list`.
-    #[arg(required = true, value_name = "STUDY")]
+    #[arg(required_unless_present = "solve_case", value_name = "STUDY")]
     studies: Vec<String>,
+    /// Folder of the adapters that run other codes' cases (`ext:<adapter>` methods;
+    /// studies/PROTOCOL.md). Default: `$IGIMP_ADAPTERS`, else `examples/adapters`.
+    #[arg(long, value_name = "DIR")]
+    adapters: Option<PathBuf>,
+    /// Solve one case file of the case protocol in process and write its result file, as
+    /// igimp's adapter (`examples/adapters/igimp/`) does; nothing else runs.
+    #[arg(long, num_args = 2, value_names = ["CASE_JSON", "RESULT_JSON"], conflicts_with = "studies")]
+    solve_case: Option<Vec<PathBuf>>,
     /// Run the quick tier (each sweep's `quick` overrides; what the tests and CI run).
     #[arg(long)]
     quick: bool,
@@ -339,6 +347,18 @@ fn main() -> ExitCode {
         Err(e) => e.exit(),
     };
     let dir = cli.studies_dir.clone().unwrap_or_else(default_studies_dir);
+    if let Some(a) = &cli.adapters {
+        igimp::study::external::adapter::set_adapters_dir(a.clone());
+    }
+    if let Some(files) = &cli.solve_case {
+        return match igimp::study::external::igimp_case::solve_case_file(&files[0], &files[1]) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::FAILURE
+            }
+        };
+    }
 
     if cli.studies.iter().any(|s| s == "list") {
         if cli.studies.len() > 1 {

@@ -98,6 +98,16 @@ pub trait StudyKind: Serialize + DeserializeOwned + Clone + Sync {
     fn cost(&self, case: &Self::Case) -> f64;
     /// Solve one case; with `vtk`, also write its ParaView files.
     fn solve(&self, case: &Self::Case, vtk: Option<&VtkTarget>) -> Result<Self::Output, StudyError>;
+    /// [`Self::solve`] given the study's output folder (`None`: an in-memory run), for a kind
+    /// whose cases keep files of their own (an external code's case and result files).
+    fn solve_in(
+        &self,
+        case: &Self::Case,
+        vtk: Option<&VtkTarget>,
+        _study_dir: Option<&Path>,
+    ) -> Result<Self::Output, StudyError> {
+        self.solve(case, vtk)
+    }
     fn record(output: &Self::Output) -> &Self::Record;
     /// Fill the measures and checks of `results`, whose cases are solved.
     fn measure(results: &mut Results<Self>);
@@ -339,7 +349,7 @@ fn solve_all<K: StudyKind>(
         |c| -> Result<Result<Finished<K>, Refusal>, StudyError> {
             let key = study.key(c);
             let (Some(store), Some(dir)) = (&store, &options.study_dir) else {
-                let o = study.solve(c, None)?;
+                let o = study.solve_in(c, None, None)?;
                 done(&key.id, &o);
                 return Ok(Ok((o, None)));
             };
@@ -368,7 +378,7 @@ fn solve_all<K: StudyKind>(
                 options,
             });
             let t = Instant::now();
-            let output = study.solve(c, vtk.as_ref())?;
+            let output = study.solve_in(c, vtk.as_ref(), Some(dir))?;
             let seconds = t.elapsed().as_secs_f64();
             // The phases so far; the engine's own measure (store write included) replaces
             // this one for a case solved now.

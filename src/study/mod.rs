@@ -20,6 +20,7 @@ pub mod column;
 pub mod compaction;
 pub mod dynamics;
 pub mod engine;
+pub mod external;
 pub mod kinds;
 pub mod locate;
 pub mod manufactured;

@@ -57,14 +57,26 @@ fn dlog_matches_central_differences() {
     }
 }
 
-/// D^alg of the linear elastic model matches central differences of its stress update.
+/// D^alg of the elastic models (Hencky, neo-Hookean) matches central differences of their
+/// stress update, at strains up to ±0.3 (the neo-Hookean tangent is not constant).
 #[test]
 fn constitutive_tangent_matches_central_differences() {
-    let model = LinearElastic::try_new(2.1e5, 0.3).unwrap();
+    let hencky = LinearElastic::try_new(2.1e5, 0.3).unwrap();
+    let neo = igimp::material::constitutive::NeoHookean::try_new(2.1e5, 0.3).unwrap();
+    for (model, spread) in [
+        (&hencky as &dyn ConstitutiveModel, 0.05),
+        (&neo, 0.05),
+        (&neo, 0.3),
+    ] {
+        constitutive_tangent_check(model, spread);
+    }
+}
+
+fn constitutive_tangent_check(model: &dyn ConstitutiveModel, spread: f64) {
     let mut rng = Rng::new(12);
     let state = MaterialState::default();
     for _ in 0..20 {
-        let a = Matrix3::from_fn(|_, _| rng.uniform(-0.05, 0.05));
+        let a = Matrix3::from_fn(|_, _| rng.uniform(-spread, spread));
         let eps = 0.5 * (a + a.transpose());
         model.update(&eps, &state).unwrap();
         let h = 1e-7;
@@ -78,7 +90,10 @@ fn constitutive_tangent_matches_central_differences() {
                     / (2.0 * h);
                 let d_alg = model.tangent(&eps, &state);
                 let an = contract(&d_alg, &d);
-                assert!((fd - an).amax() <= 1e-6 * d_alg.amax(), "D^alg mismatch");
+                assert!(
+                    (fd - an).amax() <= 1e-6 * d_alg.amax(),
+                    "D^alg mismatch: {fd} against {an}"
+                );
             }
         }
     }
@@ -612,5 +627,24 @@ fn tangent_by_rows_equals_tangent_by_columns_to_the_bit() {
                 .count();
             assert_eq!(differ, 0, "{basis:?}: {differ} of {} entries differ", n * n);
         }
+    }
+}
+
+/// The neo-Hookean model's Kirchhoff stress at F = [[1.1, 0.05], [0.02, 0.9]] (plane strain,
+/// E = 1e5, ν = 0.3) equals Kratos MPM 10.4.4's `HyperElasticNeoHookeanPlaneStrain2DLaw`
+/// (its `CalculateMaterialResponseKirchhoff`, printed to 12 digits: reference/README.md item
+/// 67), to 1e-10 relative: τ_xx, τ_yy, τ_xy.
+#[test]
+fn neo_hookean_stress_equals_kratos_law() {
+    let model = igimp::material::constitutive::NeoHookean::try_new(1e5, 0.3).unwrap();
+    let f = Matrix3::new(1.1, 0.05, 0.0, 0.02, 0.9, 0.0, 0.0, 0.0, 1.0);
+    let eps = log_strain(&(f * f.transpose())).unwrap();
+    let tau = model.update(&eps, &MaterialState::default()).unwrap().tau;
+    let kratos = [7534.94534465, -7930.43927074, 2576.92307692];
+    for (got, want) in [tau[(0, 0)], tau[(1, 1)], tau[(0, 1)]].iter().zip(kratos) {
+        assert!(
+            (got - want).abs() <= 1e-10 * 7930.0,
+            "{got} against Kratos' {want}"
+        );
     }
 }

@@ -15,10 +15,12 @@
 //! (`examples/hardening_von_mises.rs`).
 
 mod linear_elastic;
+mod neo_hookean;
 pub mod registry;
 mod von_mises;
 
 pub use linear_elastic::{lame, LinearElastic, ENTRY as LINEAR_ELASTIC};
+pub use neo_hookean::{NeoHookean, ENTRY as NEO_HOOKEAN};
 pub use registry::{Material, ModelEntry, Parameter};
 pub use von_mises::{VonMises, ENTRY as VON_MISES, PLASTIC_MULTIPLIER};
 

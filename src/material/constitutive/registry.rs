@@ -53,8 +53,9 @@ pub struct ModelEntry {
     pub build: fn(&Material) -> Result<Box<dyn ConstitutiveModel>, InputError>,
 }
 
-/// The models igimp ships: Hencky elasticity and von Mises perfect plasticity.
-pub static BUILT_IN: [&ModelEntry; 2] = [&super::LINEAR_ELASTIC, &super::VON_MISES];
+/// The models igimp ships: Hencky elasticity, von Mises perfect plasticity and compressible
+/// neo-Hookean elasticity.
+pub static BUILT_IN: [&ModelEntry; 3] = [&super::LINEAR_ELASTIC, &super::VON_MISES, &super::NEO_HOOKEAN];
 
 /// Models added by the program ([`register`]), after the built-in ones.
 static REGISTERED: RwLock<Vec<&'static ModelEntry>> = RwLock::new(Vec::new());

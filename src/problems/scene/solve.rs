@@ -2,17 +2,13 @@
 //! supports and displacement loads turned into node dofs, gravity and the ramps applied, the
 //! load steps run, and the measures read after every step.
 
-use super::build::{
-    body_mesh, cells, fill_points, fixed_dofs, prescribed, region_dofs, traction_nodal_forces,
-    traction_point_loads, NamedDofs,
-};
+use super::build::{body_mesh, fixed_dofs, prescribed, region_dofs, traction_nodal_forces, NamedDofs};
 use super::spec::{axis_index, LoadKind, MeasureKind, Scene, SceneSettings};
 use crate::basis::method::Method;
 use crate::basis::Basis;
 use crate::fem::{ContinuumFem, ElementFamily, FemLoads, HexElement, PlaneFemSettings, QuadElement};
 use crate::material::kinematics::PointState;
-use crate::mesh::grid::Grid;
-use crate::mpm::{Loads, MpmSettings, MpmSolver};
+use crate::mpm::MpmSolver;
 use crate::solver::dynamics::BodyForce;
 use crate::solver::error::{InputError, SolveError};
 use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
@@ -77,10 +73,6 @@ pub fn solve(scene: &Scene, settings: &SceneSettings, method: Method) -> Result<
     }
 }
 
-fn fixed_array<const D: usize>(v: &[f64]) -> [f64; D] {
-    std::array::from_fn(|a| v[a])
-}
-
 /// The node dofs (node, axis, value) of every support (value 0) and displacement load, by
 /// the name of its region, from the nodes' positions: an error names a region on no node.
 /// Σ of the gravity loads with a linear ramp, and those with a table.
@@ -124,20 +116,26 @@ fn energy(state: &PointState, volume0: f64, young: f64, poisson: f64) -> f64 {
 }
 
 /// What the measures read from a solver.
-struct Probe<'a> {
-    displacement: &'a dyn Fn(&[f64], usize, bool) -> f64,
+/// A region's reaction along an axis, by the region's name.
+pub(super) type RegionReaction<'a> = &'a dyn Fn(&str, usize) -> Option<f64>;
+
+pub(super) struct Probe<'a> {
+    pub displacement: &'a dyn Fn(&[f64], usize, bool) -> f64,
     /// The reaction at (node, axis).
-    reaction: &'a dyn Fn(usize, usize) -> f64,
+    pub reaction: &'a dyn Fn(usize, usize) -> f64,
+    /// A region's reaction along an axis, where only the regions' sums are known (a case
+    /// solved by another code); `None`: summed from `reaction`.
+    pub region_reaction: Option<RegionReaction<'a>>,
     /// Calls its argument with every integration point's initial position, initial volume
     /// and committed state.
-    points: PointVisitor<'a>,
+    pub points: PointVisitor<'a>,
 }
 
 /// Calls its argument with each integration point's X₀, current x, V₀ and state.
-type PointVisitor<'a> = &'a dyn Fn(PointSink<'_>);
+pub(super) type PointVisitor<'a> = &'a dyn Fn(PointSink<'_>);
 
 /// What a [`PointVisitor`] calls with X₀, x, V₀ and the state of each point.
-type PointSink<'a> = &'a mut dyn FnMut(&[f64], &[f64], f64, &PointState);
+pub(super) type PointSink<'a> = &'a mut dyn FnMut(&[f64], &[f64], f64, &PointState);
 
 /// The Cauchy stress component `m.component` (`xx`, `yy`, `xy`, …) along the segment from
 /// `m.at` to `m.to` in the current configuration, at `m.samples` equally spaced points: at
@@ -213,13 +211,13 @@ fn column_stress_error(scene: &Scene, points: PointVisitor<'_>) -> f64 {
 /// One measure read after a step: its value and, for a stress line, its samples (the value
 /// is their mean).
 #[derive(Debug, Clone)]
-struct Reading {
+pub(super) struct Reading {
     value: f64,
     profile: Vec<f64>,
 }
 
 /// Every measure of `scene` from `probe`, with the region dofs `named`.
-fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>) -> Vec<Reading> {
+pub(super) fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>) -> Vec<Reading> {
     let value = |value: f64| Reading {
         value,
         profile: vec![],
@@ -239,6 +237,15 @@ fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>) -> Vec<Rea
                     axis,
                     m.domain_edge,
                 )),
+                MeasureKind::Reaction if probe.region_reaction.is_some() => {
+                    let region = m.region.as_deref().unwrap_or("");
+                    value(
+                        probe
+                            .region_reaction
+                            .and_then(|r| r(region, axis))
+                            .unwrap_or(f64::NAN),
+                    )
+                }
                 MeasureKind::Reaction => {
                     let dofs = named
                         .iter()
@@ -273,7 +280,7 @@ fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>) -> Vec<Rea
 /// The measures after the run, from the readings after each converged step: the final
 /// values (and stress-line samples) are the last step's, or `unloaded`'s when no step
 /// converged, never those of a failed attempt (its reactions would be the failed iterate's).
-fn gather(
+pub(super) fn gather(
     scene: &Scene,
     history: Vec<Vec<Reading>>,
     unloaded: impl FnOnce() -> Vec<Reading>,
@@ -306,44 +313,9 @@ fn solve_mpm<const D: usize>(
     s: &SceneSettings,
     basis: Basis,
 ) -> Result<SceneOutcome, InputError> {
-    let h = s.element_size;
-    let mut n = [0; D];
-    for a in 0..D {
-        n[a] = cells(&format!("grid.extent[{a}]"), scene.grid.extent[a], h)?;
-    }
-    let grid = Grid::try_new(fixed_array::<D>(&scene.grid.origin), [h; D], n)?;
-    let points = fill_points(scene, &grid, s.points_per_cell)?;
-    let named = region_dofs(scene, h, &|f| {
-        for k in 0..grid.num_nodes() {
-            f(k, grid.node_position(k).as_slice())
-        }
-    })?;
-    let (g, tabled) = gravity::<D>(scene);
-    let fixed = fixed_dofs(&named);
-    let settings = MpmSettings {
-        basis,
-        domain_update: s.domain_update,
-        newton: s.newton,
-        load_steps: s.load_steps,
-        weak_node_tolerance: 0.0,
-        weak_node_treatment: Default::default(),
-        volume_update: Default::default(),
-        linear_solver: s.linear_solver,
-        ghost: s.ghost,
-        dynamics: None,
-    };
-    let model = scene.materials[&scene.bodies[0].material].build()?;
-    let loads = Loads {
-        gravity: g,
-        point_loads: traction_point_loads(scene, &points, h),
-    };
-    let mut solver = MpmSolver::try_new(grid, points, model, fixed, loads, settings)?;
-    if let Some(b) = tabled_body_force(scene, tabled) {
-        solver.set_body_force(b);
-    }
-    for (values, ramp) in prescribed(&named) {
-        solver.prescribe(values, ramp.clone())?;
-    }
+    let discrete = super::discrete::DiscreteScene::of(scene, s)?;
+    let named = discrete.named_dofs();
+    let mut solver = discrete.solver::<D>(basis, s)?;
     let measure = |solver: &MpmSolver<D>| {
         let pts = &solver.points;
         let displacement = |at: &[f64], axis: usize, edge: bool| {
@@ -371,6 +343,7 @@ fn solve_mpm<const D: usize>(
             &Probe {
                 displacement: &displacement,
                 reaction: &reaction,
+                region_reaction: None,
                 points: &points,
             },
         )
@@ -446,6 +419,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
             &Probe {
                 displacement: &displacement,
                 reaction: &reaction,
+                region_reaction: None,
                 points: &points,
             },
         )

@@ -7,48 +7,94 @@ use super::{RateRecord, ReferenceValue, SceneCase, SceneMeasures, SceneRecord, S
 use crate::problems::scene::{solve, ClosedForm, Scene};
 use crate::study::checks::{check_at_most, check_rate, CheckRecord, GciRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
+use crate::study::external::{self, StudyMethod};
 use crate::study::results::{CaseStatus, SolveRecord, SweepIndex};
 use crate::study::vtk_output::{write_domain_frames, DomainBox, DomainFrame};
 use crate::study::{StudyError, Tier};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-fn solve_case(scene: &Scene, case: &SceneCase) -> (SceneRecord, Vec<crate::problems::scene::PointRecord>) {
-    let (solve, o) = match solve(scene, &case.settings, case.method) {
-        Err(e) => (SolveRecord::rejected(e), None),
-        Ok(o) => (SolveRecord::of(&o.steps, o.failure.as_ref()), Some(o)),
-    };
-    let mut measures = BTreeMap::new();
-    let mut histories = BTreeMap::new();
-    let mut profiles = BTreeMap::new();
-    if let Some(o) = &o {
-        for m in &o.measures {
-            if m.value.is_finite() && !o.steps.is_empty() {
-                measures.insert(m.name.clone(), m.value);
-            }
-            if !m.history.is_empty() {
-                histories.insert(m.name.clone(), m.history.clone());
-            }
-            if !m.profile.is_empty() && !o.steps.is_empty() {
-                profiles.insert(m.name.clone(), m.profile.clone());
-            }
-        }
-    }
-    let rec = SceneRecord {
+fn solve_case(
+    scene: &Scene,
+    case: &SceneCase,
+    study_dir: Option<&Path>,
+) -> (SceneRecord, Vec<crate::problems::scene::PointRecord>) {
+    let mut rec = SceneRecord {
         id: case.id.clone(),
-        method: case.method,
+        method: case.method.clone(),
         h: case.settings.element_size,
         points_per_cell: case
             .method
             .uses_material_points()
             .then_some(case.settings.points_per_cell),
-        solve,
-        measures,
-        histories,
-        profiles,
-        points: o.as_ref().map_or(0, |o| o.size),
+        solve: SolveRecord::rejected(""),
+        measures: BTreeMap::new(),
+        histories: BTreeMap::new(),
+        profiles: BTreeMap::new(),
+        points: 0,
+        positions: vec![],
+        external: None,
     };
-    (rec, o.map_or(vec![], |o| o.points))
+    let (measures, points) = match &case.method {
+        StudyMethod::External(e) => {
+            // The case's files stay under the study's folder; an in-memory run's in a
+            // temporary folder, removed after.
+            let (folder, shown, temporary) = match study_dir {
+                Some(d) => (
+                    d.join("external").join(&case.id),
+                    format!("external/{}", case.id),
+                    false,
+                ),
+                None => (
+                    std::env::temp_dir().join(format!("igimp-ext-{}-{}", std::process::id(), case.id)),
+                    String::new(),
+                    true,
+                ),
+            };
+            let o = external::solve(scene, &case.settings, e, &case.id, &folder, &shown);
+            if temporary {
+                let _ = std::fs::remove_dir_all(&folder);
+            }
+            rec.solve = o.solve;
+            rec.points = o.points;
+            rec.external = Some(o.record);
+            if case.positions && !rec.solve.steps.is_empty() {
+                rec.positions = o.positions;
+            }
+            (o.measures, vec![])
+        }
+        StudyMethod::Own(m) => match solve(scene, &case.settings, *m) {
+            Err(e) => {
+                rec.solve = SolveRecord::rejected(e);
+                (vec![], vec![])
+            }
+            Ok(o) => {
+                rec.solve = SolveRecord::of(&o.steps, o.failure.as_ref());
+                rec.points = o.size;
+                if o.steps.is_empty() {
+                    (vec![], o.points)
+                } else {
+                    if case.positions {
+                        let d = scene.dimension;
+                        rec.positions = o.points.iter().map(|p| p.x[..d].to_vec()).collect();
+                    }
+                    (o.measures, o.points)
+                }
+            }
+        },
+    };
+    for m in &measures {
+        if m.value.is_finite() && !rec.solve.steps.is_empty() {
+            rec.measures.insert(m.name.clone(), m.value);
+        }
+        if !m.history.is_empty() {
+            rec.histories.insert(m.name.clone(), m.history.clone());
+        }
+        if !m.profile.is_empty() && !rec.solve.steps.is_empty() {
+            rec.profiles.insert(m.name.clone(), m.profile.clone());
+        }
+    }
+    (rec, points)
 }
 
 impl StudyKind for SceneStudy {
@@ -63,15 +109,43 @@ impl StudyKind for SceneStudy {
         self.cases(tier)
     }
     fn key(&self, c: &SceneCase) -> CaseKey {
-        // The scene is part of every case's definition: editing it re-solves the cases.
-        CaseKey::of_spec(&c.id, c.method, &(&self.scene(), &c.settings), 0)
+        // The scene is part of every case's definition: editing it re-solves the cases; an
+        // external case's, its adapter's manifest too.
+        match &c.method {
+            StudyMethod::Own(m) if !c.positions => {
+                CaseKey::of_spec(&c.id, *m, &(&self.scene(), &c.settings), 0)
+            }
+            StudyMethod::Own(m) => CaseKey::of_spec(&c.id, *m, &(&self.scene(), &c.settings, true), 0),
+            StudyMethod::External(e) => CaseKey {
+                id: c.id.clone(),
+                hash: crate::study::store::case_hash(&(
+                    &c.id,
+                    c.method.name(),
+                    &self.scene(),
+                    &c.settings,
+                    c.positions,
+                    crate::study::external::adapter::Adapter::find(&e.adapter)
+                        .map(|a| a.text)
+                        .unwrap_or_default(),
+                )),
+                has_vtk: false,
+            },
+        }
     }
     fn cost(&self, c: &SceneCase) -> f64 {
         let s = &c.settings;
         (s.points_per_cell as f64 / s.element_size).powi(self.dimension as i32) * s.load_steps as f64
     }
     fn solve(&self, c: &SceneCase, vtk: Option<&VtkTarget>) -> Result<SceneRecord, StudyError> {
-        let (rec, points) = solve_case(&self.scene(), c);
+        self.solve_in(c, vtk, None)
+    }
+    fn solve_in(
+        &self,
+        c: &SceneCase,
+        vtk: Option<&VtkTarget>,
+        study_dir: Option<&Path>,
+    ) -> Result<SceneRecord, StudyError> {
+        let (rec, points) = solve_case(&self.scene(), c, study_dir);
         if let (Some(v), false) = (vtk, points.is_empty()) {
             let d = self.dimension as usize;
             let boxes = |initial: bool| -> Vec<DomainBox> {
@@ -220,7 +294,7 @@ fn measures(results: &SceneResults) -> SceneMeasures {
                 let method = cases
                     .iter()
                     .find(|c| c.method.name() == method)
-                    .map(|c| c.method)
+                    .map(|c| c.method.clone())
                     .expect("a case of the series");
                 rates.push(RateRecord {
                     sweep: s.id.clone(),
@@ -296,6 +370,54 @@ fn checks(results: &SceneResults) -> Vec<CheckRecord> {
             &e.source,
         ));
     }
+    let extent = scene_extent(study);
+    for e in &study.expect_agreement {
+        let cases = results.sweep(&e.sweep);
+        let of = |m: &StudyMethod| -> Vec<&SceneRecord> {
+            cases.iter().copied().filter(|c| &c.method == m).collect()
+        };
+        let (a, b) = (of(&e.methods[0]), of(&e.methods[1]));
+        if a.is_empty() && b.is_empty() {
+            continue;
+        }
+        // Every pair at one h and points per cell; a pair with a failed case, or without
+        // positions, leaves the check not evaluated.
+        let mut worst: Option<f64> = Some(0.0);
+        let mut pairs = 0;
+        for x in &a {
+            let Some(y) = b
+                .iter()
+                .find(|y| y.h == x.h && y.points_per_cell == x.points_per_cell)
+            else {
+                continue;
+            };
+            pairs += 1;
+            let ok = x.solve.status == CaseStatus::Converged
+                && y.solve.status == CaseStatus::Converged
+                && x.positions.len() == y.positions.len()
+                && !x.positions.is_empty();
+            worst = worst.filter(|_| ok).map(|w| {
+                x.positions
+                    .iter()
+                    .zip(&y.positions)
+                    .flat_map(|(p, q)| p.iter().zip(q).map(|(u, v)| (u - v).abs()))
+                    .fold(w, f64::max)
+            });
+        }
+        if pairs == 0 {
+            worst = None;
+        }
+        out.push(check_at_most(
+            &format!("{}-{}-{}-agreement", e.sweep, e.methods[0].slug(), e.methods[1].slug()),
+            format!(
+                "final point positions of {} and {} in sweep {} agree to {:e} of the scene's largest body extent {extent} (measured: the largest difference over {pairs} pairs of cases, over {extent})",
+                e.methods[0], e.methods[1], e.sweep, e.tolerance
+            ),
+            worst.map(|w| w / extent),
+            e.tolerance,
+            &e.source,
+        ));
+    }
     for e in &study.expect_rate {
         for r in results
             .measures
@@ -328,4 +450,18 @@ fn checks(results: &SceneResults) -> Vec<CheckRecord> {
         }
     }
     out
+}
+
+/// The largest side of the bodies' bounding boxes.
+fn scene_extent(study: &SceneStudy) -> f64 {
+    study
+        .bodies
+        .iter()
+        .flat_map(|b| {
+            let bx = b.bounding_box();
+            (0..bx.min.len())
+                .map(move |a| bx.max[a] - bx.min[a])
+                .collect::<Vec<f64>>()
+        })
+        .fold(0.0, f64::max)
 }

@@ -8,9 +8,9 @@ mod validate;
 
 use super::material::MaterialTable;
 use super::vocabulary::{ExpectedFailure, NewtonSection};
-use crate::basis::method::Method;
 use crate::discretise::ghost::GhostSettings;
 use crate::problems::scene::{Body, GridSection, Load, Measure, Scene, SceneSettings, Support};
+use crate::study::external::{ExternalRecord, StudyMethod};
 use crate::study::results::{case_record, Envelope, SolveRecord};
 use crate::study::Tier;
 use serde::{Deserialize, Serialize};
@@ -23,7 +23,7 @@ pub struct SceneSweepQuick {
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub skip: bool,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub methods: Option<Vec<Method>>,
+    pub methods: Option<Vec<StudyMethod>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub element_sizes: Option<Vec<f64>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -36,7 +36,8 @@ pub struct SceneSweepQuick {
 pub struct SceneSweep {
     pub id: String,
     pub title: String,
-    pub methods: Vec<Method>,
+    /// igimp's methods, and other codes' as `ext:<adapter>[@<method>]` (studies/PROTOCOL.md).
+    pub methods: Vec<StudyMethod>,
     pub element_sizes: Vec<f64>,
     /// Points per cell along each axis (material point methods; FEM cases ignore it).
     pub points_per_cell: Vec<i64>,
@@ -70,7 +71,20 @@ pub struct ReferenceExpectation {
     pub measure: String,
     pub sweep: String,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub methods: Vec<Method>,
+    pub methods: Vec<StudyMethod>,
+    pub tolerance: f64,
+    pub source: String,
+}
+
+/// Two methods of `sweep` agree point by point: at every element size and points per cell
+/// both ran, the largest difference of a final point position, over the scene's largest
+/// body extent, is at most `tolerance` (both solve the same points: an external code gets
+/// igimp's through the case protocol).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AgreementExpectation {
+    pub sweep: String,
+    pub methods: [StudyMethod; 2],
     pub tolerance: f64,
     pub source: String,
 }
@@ -82,7 +96,7 @@ pub struct ReferenceExpectation {
 pub struct RateExpectation {
     pub measure: String,
     pub sweep: String,
-    pub method: Method,
+    pub method: StudyMethod,
     pub rate: f64,
     pub tolerance: f64,
     pub source: String,
@@ -120,13 +134,17 @@ pub struct SceneStudy {
     pub expect_reference: Vec<ReferenceExpectation>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub expect_rate: Vec<RateExpectation>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expect_agreement: Vec<AgreementExpectation>,
 }
 
 /// One case to solve.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SceneCase {
     pub id: String,
-    pub method: Method,
+    pub method: StudyMethod,
+    /// Keep the final point positions (a sweep an agreement check compares).
+    pub positions: bool,
     pub settings: SceneSettings,
 }
 
@@ -134,7 +152,7 @@ pub struct SceneCase {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SceneRecord {
     pub id: String,
-    pub method: Method,
+    pub method: StudyMethod,
     pub h: f64,
     /// `None` (null) for FEM.
     pub points_per_cell: Option<usize>,
@@ -150,6 +168,12 @@ pub struct SceneRecord {
     pub profiles: BTreeMap<String, Vec<f64>>,
     /// Material points or elements.
     pub points: usize,
+    /// Final point positions, for the agreement checks (converged steps only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub positions: Vec<Vec<f64>>,
+    /// An external code's case: the code, its timing and its files.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub external: Option<ExternalRecord>,
 }
 
 case_record!(SceneRecord);
@@ -179,7 +203,7 @@ impl ReferenceValue {
 pub struct RateRecord {
     pub sweep: String,
     pub measure: String,
-    pub method: Method,
+    pub method: StudyMethod,
     pub points_per_cell: Option<usize>,
     /// (h, relative error) coarse to fine.
     pub errors: Vec<(f64, f64)>,
@@ -222,7 +246,7 @@ impl SceneStudy {
     }
 
     /// (methods, element sizes, points per cell) of `sweep` in `tier`; `None` if skipped.
-    pub fn plan(&self, s: &SceneSweep, tier: Tier) -> Option<(Vec<Method>, Vec<f64>, Vec<i64>)> {
+    pub fn plan(&self, s: &SceneSweep, tier: Tier) -> Option<(Vec<StudyMethod>, Vec<f64>, Vec<i64>)> {
         if tier == Tier::Quick && s.quick.skip {
             return None;
         }
@@ -265,10 +289,10 @@ impl SceneStudy {
 
     /// A case's id: method, h and points per cell (material points), and the load steps if
     /// the sweep sets its own.
-    pub fn case_id(&self, s: &SceneSweep, method: Method, settings: &SceneSettings) -> String {
+    pub fn case_id(&self, s: &SceneSweep, method: &StudyMethod, settings: &SceneSettings) -> String {
         let mut id = format!(
             "{}-h{}",
-            method.name(),
+            method.slug(),
             super::vocabulary::number(settings.element_size)
         );
         if method.uses_material_points() {
@@ -296,7 +320,8 @@ impl SceneStudy {
         let sweeps = self.sweeps.iter().filter_map(|s| {
             let (methods, sizes, ppcs) = self.plan(s, tier)?;
             let mut cases = vec![];
-            for &method in &methods {
+            let positions = self.expect_agreement.iter().any(|e| e.sweep == s.id);
+            for method in &methods {
                 for &h in &sizes {
                     // FEM cases have no points per cell: one case per h.
                     let ppcs: Vec<i64> = if method.uses_material_points() {
@@ -307,7 +332,12 @@ impl SceneStudy {
                     for &p in &ppcs {
                         let settings = self.settings(s, h, p.max(1) as usize);
                         let id = self.case_id(s, method, &settings);
-                        cases.push(SceneCase { id, method, settings });
+                        cases.push(SceneCase {
+                            id,
+                            method: method.clone(),
+                            positions,
+                            settings,
+                        });
                     }
                 }
             }

@@ -3,8 +3,10 @@
 //! (a region on no node, a body off the point lattice) and the expectations.
 
 use super::SceneStudy;
+use crate::basis::method::Method;
 use crate::problems::scene::{check_resolution, methods, LoadKind};
 use crate::solver::newton::ResidualNorm;
+use crate::study::external::StudyMethod;
 use crate::study::vocabulary::{Checker, Header};
 use crate::study::{StudyError, Tier};
 use std::collections::BTreeSet;
@@ -72,8 +74,26 @@ impl SceneStudy {
                 chk.non_empty(&k("element_sizes"), &sizes)?;
                 chk.non_empty(&k("points_per_cell"), &ppcs)?;
                 for (j, m) in ms.iter().enumerate() {
-                    if !allowed.contains(m) {
-                        let e = m.unsupported(&format!("a scene in dimension {}", scene.dimension), allowed);
+                    // An external code solves igimp's material points: its basis (if named)
+                    // must be a material point one. Whether its adapter exists and supports
+                    // the scene is the case's to find out (a recorded failure, not an
+                    // invalid study).
+                    let own = match m {
+                        StudyMethod::Own(m) => *m,
+                        StudyMethod::External(e) => match e.basis {
+                            Some(b) if !b.uses_material_points() => {
+                                return Err(chk.err(
+                                    format!("{}[{j}]", k("methods")),
+                                    m,
+                                    "an external code solves the case's material points: its basis after @ must be a material point method",
+                                ))
+                            }
+                            b => b.unwrap_or(Method::MPM),
+                        },
+                    };
+                    if !allowed.contains(&own) {
+                        let e =
+                            own.unsupported(&format!("a scene in dimension {}", scene.dimension), allowed);
                         return Err(chk.err(format!("{}[{j}]", k("methods")), e.value, e.allowed));
                     }
                 }
@@ -82,10 +102,11 @@ impl SceneStudy {
                 }
                 for (j, &h) in sizes.iter().enumerate() {
                     chk.positive(&format!("{}[{j}]", k("element_sizes")), h)?;
-                    for &m in &ms {
+                    for m in &ms {
+                        let own = m.own().unwrap_or(Method::MPM);
                         for &p in &ppcs {
                             let settings = self.settings(s, h, p as usize);
-                            check_resolution(&scene, &settings, m).map_err(|e| {
+                            check_resolution(&scene, &settings, own).map_err(|e| {
                                 chk.err(
                                     e.field.clone(),
                                     e.value.clone(),
@@ -123,7 +144,7 @@ impl SceneStudy {
                     ));
                 };
                 let distinct: BTreeSet<u64> = sizes.iter().map(|h| h.to_bits()).collect();
-                if ms.len() != 1 || !ms[0].is_fem() || distinct.len() < 3 {
+                if ms.len() != 1 || !ms[0].own().is_some_and(|m| m.is_fem()) || distinct.len() < 3 {
                     return Err(chk.err(
                         &key,
                         format!("{sweep:?}"),
@@ -170,12 +191,34 @@ impl SceneStudy {
             if !s.methods.contains(&e.method) {
                 return Err(chk.err(
                     format!("{key}.method"),
-                    e.method,
+                    &e.method,
                     format!("must be a method of sweep {:?}", s.id),
                 ));
             }
             if !(e.rate.is_finite() && e.rate > 0.0) {
                 return Err(chk.err(format!("{key}.rate"), e.rate, "must be finite and > 0"));
+            }
+            chk.positive(&format!("{key}.tolerance"), e.tolerance)?;
+            chk.text(&format!("{key}.source"), &e.source)?;
+        }
+        for (i, e) in self.expect_agreement.iter().enumerate() {
+            let key = format!("expect_agreement[{i}]");
+            let s = sweep(&format!("{key}.sweep"), &e.sweep)?;
+            for (j, m) in e.methods.iter().enumerate() {
+                if !s.methods.contains(m) || !m.uses_material_points() {
+                    return Err(chk.err(
+                        format!("{key}.methods[{j}]"),
+                        m,
+                        format!("must be a material point method of sweep {:?}", s.id),
+                    ));
+                }
+            }
+            if e.methods[0] == e.methods[1] {
+                return Err(chk.err(
+                    format!("{key}.methods"),
+                    &e.methods[1],
+                    "must name two different methods",
+                ));
             }
             chk.positive(&format!("{key}.tolerance"), e.tolerance)?;
             chk.text(&format!("{key}.source"), &e.source)?;

@@ -1,0 +1,205 @@
+//! A solve's state as the case protocol carries it (`studies/PROTOCOL.md`): every material
+//! point's position, Cauchy stress, deformation gradient and volume after a load step, and
+//! the reaction of each region; and a scene's measures read back from them, so that a case
+//! solved by another code is measured by the same code as one solved here.
+
+use super::build::NamedDofs;
+use super::discrete::DiscreteScene;
+use super::solve::{gather, read_measures, MeasureValue, PointSink, Probe};
+use super::spec::Scene;
+use crate::material::kinematics::{log_strain, PointState};
+use crate::mpm::particles::MaterialPoints;
+use crate::mpm::MpmSolver;
+use crate::solver::error::InputError;
+use nalgebra::Matrix3;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Every point's state after one load step. Tensors are 3 × 3, row-major (in plane strain
+/// F_zz = 1 and σ_zz is the out-of-plane stress).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointFields {
+    /// Current position x.
+    pub position: Vec<Vec<f64>>,
+    /// Cauchy stress σ.
+    pub cauchy: Vec<Vec<f64>>,
+    /// Deformation gradient F.
+    pub deformation_gradient: Vec<Vec<f64>>,
+    /// Current volume.
+    pub volume: Vec<f64>,
+    /// Half the side of the current domain along each axis (codes that track domains).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub half_length: Option<Vec<Vec<f64>>>,
+}
+
+/// Reactions summed over each region's fixed dofs: region name → one value per axis.
+pub type Reactions = BTreeMap<String, Vec<f64>>;
+
+fn row_major(m: &Matrix3<f64>) -> Vec<f64> {
+    (0..9).map(|k| m[(k / 3, k % 3)]).collect()
+}
+
+fn matrix(v: &[f64]) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| v[3 * i + j])
+}
+
+impl PointFields {
+    /// The committed state of `points`.
+    pub fn of_points<const D: usize>(points: &MaterialPoints<D>) -> Self {
+        let v = |x: &nalgebra::SVector<f64, D>| x.iter().copied().collect::<Vec<f64>>();
+        PointFields {
+            position: points.position.iter().map(v).collect(),
+            cauchy: points.state.iter().map(|s| row_major(&s.cauchy())).collect(),
+            deformation_gradient: points.state.iter().map(|s| row_major(&s.f)).collect(),
+            volume: points.state.iter().map(|s| s.volume).collect(),
+            half_length: Some(points.half_length.iter().map(v).collect()),
+        }
+    }
+
+    /// Sizes that agree with `count` points in dimension `d`, and finite values; an error
+    /// names the key under `key`.
+    pub fn validate(&self, key: &str, count: usize, d: usize) -> Result<(), InputError> {
+        let rows = |name: &str, rows: &[Vec<f64>], width: usize| -> Result<(), InputError> {
+            if rows.len() != count {
+                return Err(InputError::new(
+                    format!("{key}.{name}"),
+                    format!("{} entries", rows.len()),
+                    format!("must have one per point of the case ({count})"),
+                ));
+            }
+            for (p, r) in rows.iter().enumerate() {
+                if r.len() != width {
+                    return Err(InputError::new(
+                        format!("{key}.{name}[{p}]"),
+                        format!("{} values", r.len()),
+                        format!("must have {width}"),
+                    ));
+                }
+                if let Some(i) = r.iter().position(|v| !v.is_finite()) {
+                    return Err(InputError::new(
+                        format!("{key}.{name}[{p}][{i}]"),
+                        r[i],
+                        "must be finite",
+                    ));
+                }
+            }
+            Ok(())
+        };
+        rows("position", &self.position, d)?;
+        rows("cauchy", &self.cauchy, 9)?;
+        rows("deformation_gradient", &self.deformation_gradient, 9)?;
+        if let Some(h) = &self.half_length {
+            rows("half_length", h, d)?;
+        }
+        let volume: Vec<Vec<f64>> = self.volume.iter().map(|&v| vec![v]).collect();
+        rows("volume", &volume, 1)?;
+        for (p, f) in self.deformation_gradient.iter().enumerate() {
+            let j = matrix(f).determinant();
+            if j <= 0.0 {
+                return Err(InputError::new(
+                    format!("{key}.deformation_gradient[{p}]"),
+                    format!("det F = {j}"),
+                    "must have det F > 0",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Point `p`'s state as igimp holds it: F, volume, τ = J σ and the logarithmic strain
+    /// of F as the elastic one (exact for elastic models, which the energy measure needs).
+    fn state(&self, p: usize) -> PointState {
+        let f = matrix(&self.deformation_gradient[p]);
+        let mut s = PointState::undeformed(self.volume[p]);
+        s.tau = matrix(&self.cauchy[p]) * f.determinant();
+        s.material.eps_e = log_strain(&(f * f.transpose())).unwrap_or_else(Matrix3::zeros);
+        s.f = f;
+        s
+    }
+}
+
+/// The reaction of every region of `named`: the solver's reactions summed over its fixed
+/// dofs, per axis, in the order the measures sum them.
+pub(super) fn reactions<const D: usize>(solver: &MpmSolver<D>, named: &NamedDofs) -> Reactions {
+    named
+        .iter()
+        .map(|(name, dofs, _)| {
+            let r = (0..D)
+                .map(|a| {
+                    dofs.iter()
+                        .filter(|d| d.1 == a)
+                        .map(|&(n, a)| solver.reaction(n, a))
+                        .sum()
+                })
+                .collect();
+            (name.clone(), r)
+        })
+        .collect()
+}
+
+/// The measures of `scene` (resolved as `discrete`) from the fields and reactions after each
+/// converged step, as [`super::solve`] reads them from a solver: the points are `discrete`'s,
+/// in order. A measure the fields cannot give (a domain edge without domains) is NaN.
+pub fn measures_of_fields(
+    scene: &Scene,
+    discrete: &DiscreteScene,
+    steps: &[(PointFields, Reactions)],
+) -> Vec<MeasureValue> {
+    let named = discrete.named_dofs();
+    let x0 = &discrete.points.position;
+    let read = |fields: &PointFields, reactions: &Reactions| {
+        let displacement = |at: &[f64], axis: usize, edge: bool| {
+            let dist = |p: usize| -> f64 { x0[p].iter().zip(at).map(|(a, b)| (a - b) * (a - b)).sum() };
+            let Some(p) = (0..x0.len()).min_by(|&a, &b| dist(a).total_cmp(&dist(b))) else {
+                return f64::NAN;
+            };
+            let grow = match (&fields.half_length, edge) {
+                (_, false) => 0.0,
+                (Some(h), true) => {
+                    (h[p][axis] - discrete.points.half_length[p][axis]) * (at[axis] - x0[p][axis]).signum()
+                }
+                (None, true) => f64::NAN,
+            };
+            fields.position[p][axis] - x0[p][axis] + grow
+        };
+        // A region's reaction along `axis`, once per region: the probe is asked per dof.
+        let reaction_of = |name: &str, axis: usize| reactions.get(name).and_then(|r| r.get(axis).copied());
+        let points = |f: PointSink<'_>| {
+            for p in 0..x0.len() {
+                f(
+                    &x0[p],
+                    &fields.position[p],
+                    discrete.points.volume[p],
+                    &fields.state(p),
+                );
+            }
+        };
+        read_measures(
+            scene,
+            &named,
+            &Probe {
+                displacement: &displacement,
+                reaction: &|_, _| f64::NAN,
+                region_reaction: Some(&reaction_of),
+                points: &points,
+            },
+        )
+    };
+    let history = steps.iter().map(|(f, r)| read(f, r)).collect();
+    let unloaded = || {
+        let fields = PointFields {
+            position: x0.clone(),
+            cauchy: vec![row_major(&Matrix3::zeros()); x0.len()],
+            deformation_gradient: vec![row_major(&Matrix3::identity()); x0.len()],
+            volume: discrete.points.volume.clone(),
+            half_length: Some(discrete.points.half_length.clone()),
+        };
+        let zero = named
+            .iter()
+            .map(|n| (n.0.clone(), vec![0.0; discrete.dimension]))
+            .collect();
+        read(&fields, &zero)
+    };
+    gather(scene, history, unloaded)
+}
