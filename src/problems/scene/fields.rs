@@ -7,7 +7,7 @@ use super::build::NamedDofs;
 use super::discrete::DiscreteScene;
 use super::solve::{gather, read_measures, MeasureValue, PointSink, Probe};
 use super::spec::Scene;
-use crate::material::kinematics::{log_strain, PointState};
+use crate::material::kinematics::{log_strain, spectral_map, sym_eigen, PointState};
 use crate::mpm::particles::MaterialPoints;
 use crate::mpm::MpmSolver;
 use crate::solver::error::InputError;
@@ -24,8 +24,13 @@ pub struct PointFields {
     pub position: Vec<Vec<f64>>,
     /// Cauchy stress σ.
     pub cauchy: Vec<Vec<f64>>,
-    /// Deformation gradient F.
-    pub deformation_gradient: Vec<Vec<f64>>,
+    /// Deformation gradient F; or, from a code that does not give F,
+    /// `left_cauchy_green` (every measure needs only b and σ).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deformation_gradient: Option<Vec<Vec<f64>>>,
+    /// Left Cauchy–Green tensor b = F Fᵀ, when F is not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub left_cauchy_green: Option<Vec<Vec<f64>>>,
     /// Current volume.
     pub volume: Vec<f64>,
     /// Half the side of the current domain along each axis (codes that track domains).
@@ -51,7 +56,8 @@ impl PointFields {
         PointFields {
             position: points.position.iter().map(v).collect(),
             cauchy: points.state.iter().map(|s| row_major(&s.cauchy())).collect(),
-            deformation_gradient: points.state.iter().map(|s| row_major(&s.f)).collect(),
+            deformation_gradient: Some(points.state.iter().map(|s| row_major(&s.f)).collect()),
+            left_cauchy_green: None,
             volume: points.state.iter().map(|s| s.volume).collect(),
             half_length: Some(points.half_length.iter().map(v).collect()),
         }
@@ -88,32 +94,69 @@ impl PointFields {
         };
         rows("position", &self.position, d)?;
         rows("cauchy", &self.cauchy, 9)?;
-        rows("deformation_gradient", &self.deformation_gradient, 9)?;
+        match (&self.deformation_gradient, &self.left_cauchy_green) {
+            (Some(f), None) => {
+                rows("deformation_gradient", f, 9)?;
+                for (p, f) in f.iter().enumerate() {
+                    let j = matrix(f).determinant();
+                    if j <= 0.0 {
+                        return Err(InputError::new(
+                            format!("{key}.deformation_gradient[{p}]"),
+                            format!("det F = {j}"),
+                            "must have det F > 0",
+                        ));
+                    }
+                }
+            }
+            (None, Some(b)) => {
+                rows("left_cauchy_green", b, 9)?;
+                for (p, b) in b.iter().enumerate() {
+                    let m = matrix(b);
+                    let (l, _) = sym_eigen(&(0.5 * (m + m.transpose())));
+                    if (m - m.transpose()).amax() > 1e-9 * m.amax() || l.iter().any(|&x| x <= 0.0) {
+                        return Err(InputError::new(
+                            format!("{key}.left_cauchy_green[{p}]"),
+                            format!("{b:?}"),
+                            "must be symmetric positive definite",
+                        ));
+                    }
+                }
+            }
+            _ => {
+                return Err(InputError::new(
+                    key,
+                    "deformation_gradient and left_cauchy_green",
+                    "must give exactly one of the two",
+                ))
+            }
+        }
         if let Some(h) = &self.half_length {
             rows("half_length", h, d)?;
         }
         let volume: Vec<Vec<f64>> = self.volume.iter().map(|&v| vec![v]).collect();
         rows("volume", &volume, 1)?;
-        for (p, f) in self.deformation_gradient.iter().enumerate() {
-            let j = matrix(f).determinant();
-            if j <= 0.0 {
-                return Err(InputError::new(
-                    format!("{key}.deformation_gradient[{p}]"),
-                    format!("det F = {j}"),
-                    "must have det F > 0",
-                ));
-            }
-        }
         Ok(())
     }
 
-    /// Point `p`'s state as igimp holds it: F, volume, τ = J σ and the logarithmic strain
-    /// of F as the elastic one (exact for elastic models, which the energy measure needs).
+    /// Point `p`'s state as igimp holds it: F (the left stretch √b where only b is given),
+    /// volume, τ = J σ and the logarithmic strain ½ ln b as the elastic one (exact for
+    /// elastic models, which the energy measure needs).
     fn state(&self, p: usize) -> PointState {
-        let f = matrix(&self.deformation_gradient[p]);
+        let (f, b) = match (&self.deformation_gradient, &self.left_cauchy_green) {
+            (Some(f), _) => {
+                let f = matrix(&f[p]);
+                (f, f * f.transpose())
+            }
+            (None, Some(b)) => {
+                let b = matrix(&b[p]);
+                let (l, q) = sym_eigen(&b);
+                (spectral_map(&l, &q, |x| x.max(0.0).sqrt()), b)
+            }
+            (None, None) => (Matrix3::identity(), Matrix3::identity()),
+        };
         let mut s = PointState::undeformed(self.volume[p]);
         s.tau = matrix(&self.cauchy[p]) * f.determinant();
-        s.material.eps_e = log_strain(&(f * f.transpose())).unwrap_or_else(Matrix3::zeros);
+        s.material.eps_e = log_strain(&b).unwrap_or_else(Matrix3::zeros);
         s.f = f;
         s
     }
@@ -191,7 +234,8 @@ pub fn measures_of_fields(
         let fields = PointFields {
             position: x0.clone(),
             cauchy: vec![row_major(&Matrix3::zeros()); x0.len()],
-            deformation_gradient: vec![row_major(&Matrix3::identity()); x0.len()],
+            deformation_gradient: Some(vec![row_major(&Matrix3::identity()); x0.len()]),
+            left_cauchy_green: None,
             volume: discrete.points.volume.clone(),
             half_length: Some(discrete.points.half_length.clone()),
         };

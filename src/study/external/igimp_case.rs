@@ -44,6 +44,7 @@ pub fn solve(case: &CaseFile) -> ResultFile {
             reason,
             residuals: vec![],
         }),
+        residual_norm: None,
         steps: vec![],
         fields: None,
         step_fields: vec![],
@@ -101,11 +102,13 @@ fn run<const D: usize>(mut solver: MpmSolver<D>, case: &CaseFile) -> ResultFile 
             reason: e.failure.to_string(),
             residuals: e.residuals,
         }),
+        residual_norm: None,
         steps: steps
             .iter()
             .map(|s| ResultStep {
                 step: s.step,
                 load_factor: s.load_factor,
+                iterations: s.newton.iterations(),
                 residuals: s.newton.residuals.clone(),
                 seconds: None,
             })

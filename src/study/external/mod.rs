@@ -32,6 +32,9 @@ pub struct ExternalRecord {
     pub seconds: Option<f64>,
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub phases: BTreeMap<String, f64>,
+    /// The code's own residual norm, where it is not the case's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub residual_norm: Option<String>,
     /// The adapter process's wall seconds (start-up and import included).
     pub process_seconds: Option<f64>,
     /// Where the case's files are, under the study's folder.
@@ -219,6 +222,7 @@ pub fn solve(
     record.code = format!("{} {}", result.code.name, result.code.version);
     record.seconds = Some(result.timing.seconds);
     record.phases = result.timing.phases.clone();
+    record.residual_norm = result.residual_norm.clone();
     measure(scene, &case, result, record)
 }
 
@@ -254,7 +258,7 @@ fn measure(scene: &Scene, case: &CaseFile, result: ResultFile, record: ExternalR
     let solve = SolveRecord {
         status,
         failure,
-        newton_iterations: steps.iter().map(|s| s.residuals.len().saturating_sub(1)).sum(),
+        newton_iterations: result.steps.iter().map(|s| s.iterations).sum(),
         steps,
     };
     // The fields after each converged step with its reactions (only the last when the case

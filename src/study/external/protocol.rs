@@ -91,7 +91,11 @@ pub struct RunFailure {
 pub struct ResultStep {
     pub step: usize,
     pub load_factor: f64,
-    /// The normalised residual before the first Newton update and after each.
+    /// Newton iterations (linear solves) of the step.
+    pub iterations: usize,
+    /// The normalised residual before the first Newton update and after each
+    /// (`iterations` + 1 values), if the code can tell.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub residuals: Vec<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seconds: Option<f64>,
@@ -125,6 +129,10 @@ pub struct ResultFile {
     pub status: RunStatus,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub failure: Option<RunFailure>,
+    /// What the code's residuals are normalised by, where it is not the case's norm (a code
+    /// that applies its own convergence test says which).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub residual_norm: Option<String>,
     /// Every converged step, in order.
     pub steps: Vec<ResultStep>,
     /// The points after the last converged step (absent if none converged).

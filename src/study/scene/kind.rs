@@ -87,7 +87,8 @@ fn solve_case(
         if m.value.is_finite() && !rec.solve.steps.is_empty() {
             rec.measures.insert(m.name.clone(), m.value);
         }
-        if !m.history.is_empty() {
+        // A measure a case cannot give (an external code's domain edge) is absent, never NaN.
+        if !m.history.is_empty() && m.history.iter().all(|v| v.is_finite()) {
             rec.histories.insert(m.name.clone(), m.history.clone());
         }
         if !m.profile.is_empty() && !rec.solve.steps.is_empty() {
