@@ -9,6 +9,7 @@ mod committed_answers;
 mod compaction_reference_study;
 mod compaction_study;
 mod defects;
+mod external;
 mod figures;
 mod first_contact;
 mod manufactured3d_study;

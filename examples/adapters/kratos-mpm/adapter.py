@@ -243,7 +243,11 @@ def solve(case, folder):
                         du = u * (factor(r["ramp"], t) - factor(r["ramp"], t0))
                     for nd in nodes:
                         nd.Fix(components[a])
+                        # The MPM scheme's Predict (run inside InitializeSolutionStep) zeroes
+                        # the grid's DISPLACEMENT and gives a fixed dof its buffer-1 value
+                        # (mpm_residual_based_bossak_scheme.hpp): set both.
                         nd.SetSolutionStepValue(components[a], 0, du)
+                        nd.SetSolutionStepValue(components[a], 1, du)
             acc = [0.0, 0.0, 0.0]
             for gl in gravity:
                 f = factor(gl["ramp"], t)
@@ -316,8 +320,7 @@ def solve(case, folder):
         try:
             with capture:
                 sim.time = sim._AdvanceTime()
-                sim.InitializeSolutionStep()
-                solver.Predict()
+                sim.InitializeSolutionStep()  # runs the solver's Predict
                 converged = solver.SolveSolutionStep()
                 iterations = grid.ProcessInfo[KM.NL_ITERATION_NUMBER]
                 sim.FinalizeSolutionStep()

@@ -278,6 +278,7 @@ pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> Strin
         s.push('\n');
     }
     s.push_str(&checks_markdown(&r.checks));
+    s.push_str(&super::external::external_markdown(r));
     s.push_str(&super::performance_markdown(&r.cases, &r.timing));
     s.push_str(&failures_markdown(
         r.cases

@@ -1,0 +1,215 @@
+//! Other codes through the case protocol (studies/PROTOCOL.md): igimp's own adapter equals
+//! the in-process run, broken adapters fail their cases with a clear record while the study
+//! renders, and the files both sides write validate against the protocol's JSON Schemas,
+//! which refuse what the harness refuses.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// An adapters folder holding igimp's adapter and the broken ones of tests/adapters/.
+fn adapters(dir: &Path) -> PathBuf {
+    let out = dir.join("adapters");
+    for from in [root().join("examples/adapters"), root().join("tests/adapters")] {
+        for e in std::fs::read_dir(&from).unwrap() {
+            let e = e.unwrap();
+            if e.path().is_dir() {
+                let to = out.join(e.file_name());
+                std::fs::create_dir_all(&to).unwrap();
+                for f in std::fs::read_dir(e.path()).unwrap() {
+                    let f = f.unwrap();
+                    std::fs::copy(f.path(), to.join(f.file_name())).unwrap();
+                }
+            }
+        }
+    }
+    out
+}
+
+fn study(dir: &Path, file: &Path, extra: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_study"))
+        .arg(file)
+        .args(["--quick", "--out"])
+        .arg(dir.join("out"))
+        .arg("--adapters")
+        .arg(adapters(dir))
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn results(dir: &Path, name: &str) -> Value {
+    let p = dir.join("out").join(name).join("results.json");
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+/// `name`'s study file with `ext:igimp@<m>` beside each material point method `m` of every
+/// sweep (and its quick tier), as `<new>`.
+fn with_ext_igimp(name: &str, new: &str, dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(root().join("studies").join(format!("{name}.toml"))).unwrap();
+    let mut t: toml::Table = text.parse().unwrap();
+    t.insert("name".into(), new.into());
+    t.remove("expect_rate");
+    let add = |ms: &mut toml::Value| {
+        let own: Vec<String> = ms
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m.as_str().unwrap().to_string())
+            .collect();
+        let mut all = vec![];
+        for m in own {
+            if !m.starts_with("fem-") {
+                all.push(toml::Value::from(format!("ext:igimp@{m}")));
+            }
+            all.push(toml::Value::from(m));
+        }
+        *ms = toml::Value::Array(all);
+    };
+    for s in t["sweeps"].as_array_mut().unwrap() {
+        let s = s.as_table_mut().unwrap();
+        add(s.get_mut("methods").unwrap());
+        if let Some(q) = s.get_mut("quick").and_then(|q| q.get_mut("methods")) {
+            add(q);
+        }
+    }
+    let path = dir.join(format!("{new}.toml"));
+    std::fs::write(&path, toml::to_string(&t).unwrap()).unwrap();
+    path
+}
+
+fn close(a: f64, b: f64, scale: f64) -> bool {
+    (a - b).abs() <= 1e-12 * scale.max(a.abs()).max(b.abs())
+}
+
+/// ext:igimp, igimp solving a case file from its data alone through the protocol, equals the
+/// in-process run to 1e-12 on the column (eq 46), the compaction (u_max history, base force,
+/// energy) and the platen (a prescribed displacement, its reaction history and the domain
+/// edge), for every material point method of their quick tiers, with the same Newton counts.
+#[test]
+fn ext_igimp_equals_the_in_process_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut compared = 0;
+    for name in ["scene-column", "scene-compaction", "scene-platen"] {
+        let new = format!("{name}-ext");
+        let file = with_ext_igimp(name, &new, dir.path());
+        let out = study(dir.path(), &file, &[]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let r = results(dir.path(), &new);
+        let cases = r["cases"].as_array().unwrap();
+        for c in cases
+            .iter()
+            .filter(|c| c["method"].as_str().unwrap().starts_with("ext:"))
+        {
+            let own = c["method"].as_str().unwrap().trim_start_matches("ext:igimp@");
+            let id = c["id"]
+                .as_str()
+                .unwrap()
+                .replacen(&format!("ext-igimp-{own}"), own, 1);
+            let o = cases
+                .iter()
+                .find(|x| x["id"] == id.as_str())
+                .unwrap_or_else(|| panic!("{id}"));
+            assert_eq!(c["status"], "converged", "{}: {}", c["id"], c["failure"]);
+            assert_eq!(c["newton_iterations"], o["newton_iterations"], "{id}");
+            let (m, n) = (
+                c["measures"].as_object().unwrap(),
+                o["measures"].as_object().unwrap(),
+            );
+            assert_eq!(m.keys().collect::<Vec<_>>(), n.keys().collect::<Vec<_>>(), "{id}");
+            for (k, v) in m {
+                let (a, b) = (v.as_f64().unwrap(), n[k].as_f64().unwrap());
+                assert!(close(a, b, 0.0), "{id} {k}: ext {a:e}, in process {b:e}");
+                compared += 1;
+            }
+            for (k, h) in c["histories"].as_object().into_iter().flatten() {
+                let g = o["histories"][k].as_array().unwrap();
+                let scale = g.iter().map(|v| v.as_f64().unwrap().abs()).fold(0.0, f64::max);
+                for (a, b) in h.as_array().unwrap().iter().zip(g) {
+                    assert!(close(a.as_f64().unwrap(), b.as_f64().unwrap(), scale), "{id} {k}");
+                }
+                compared += 1;
+            }
+            assert!(
+                c["external"]["code"].as_str().unwrap().starts_with("igimp"),
+                "{}",
+                c["external"]
+            );
+        }
+    }
+    assert!(compared >= 20, "{compared} values compared");
+}
+
+/// A missing adapter, one that exits 1, one that writes invalid JSON, one that never
+/// finishes and one that returns a NaN stress: each fails its case with a reason that says
+/// what went wrong (the adapter's stderr tail where it has one), the in-process cases are
+/// kept, the study renders, and only `--check` turns the failures into exit status 2.
+#[test]
+fn broken_adapters_fail_their_cases_and_the_study_still_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("studies/scene-compaction.toml"))
+        .unwrap()
+        .replace("name = \"scene-compaction\"", "name = \"broken\"")
+        .replace(
+            "methods = [\"igimp\", \"fem-q4\"]",
+            "methods = [\"igimp\", \"ext:exit-one\", \"ext:bad-json\", \"ext:hang\", \"ext:nan-stress\", \"ext:no-such-code\"]",
+        )
+        .replace("element_sizes = [1.0, 0.5, 0.25]", "element_sizes = [1.0]");
+    let file = dir.path().join("broken.toml");
+    std::fs::write(&file, text).unwrap();
+    let t = std::time::Instant::now();
+    let out = study(dir.path(), &file, &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // The hung adapter is killed at its 2 s timeout, not waited for.
+    assert!(t.elapsed().as_secs_f64() < 60.0, "{:?}", t.elapsed());
+    let r = results(dir.path(), "broken");
+    let reason = |method: &str| -> String {
+        let c = r["cases"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["method"] == method)
+            .unwrap_or_else(|| panic!("{method}"));
+        assert_eq!(c["status"], "failed", "{method}");
+        c["failure"]["reason"].as_str().unwrap().to_string()
+    };
+    for (method, says) in [
+        ("ext:exit-one", "segmentation fault (simulated)"),
+        ("ext:exit-one", "exited with exit status: 1"),
+        ("ext:bad-json", "result.json is not a valid result file"),
+        ("ext:hang", "timed out after 2 s"),
+        ("ext:nan-stress", "NaN and Infinity are not JSON numbers"),
+        ("ext:no-such-code", "no adapter \"no-such-code\""),
+    ] {
+        let why = reason(method);
+        assert!(why.contains(says), "{method}: {why:?} does not say {says:?}");
+    }
+    let igimp = r["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["method"] == "igimp")
+        .unwrap();
+    assert_eq!(igimp["status"], "converged");
+    let report = std::fs::read_to_string(dir.path().join("out/broken/report.md")).unwrap();
+    for m in [
+        "ext:exit-one",
+        "ext:bad-json",
+        "ext:hang",
+        "ext:nan-stress",
+        "ext:no-such-code",
+    ] {
+        assert!(report.contains(m), "the report does not list {m}");
+    }
+    let checked = study(dir.path(), &file, &["--check", "--resume"]);
+    assert_eq!(
+        checked.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&checked.stderr)
+    );
+}
