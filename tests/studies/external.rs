@@ -213,3 +213,153 @@ fn broken_adapters_fail_their_cases_and_the_study_still_renders() {
         String::from_utf8_lossy(&checked.stderr)
     );
 }
+
+/// Verdicts of Python's jsonschema (Draft 2020-12) on `docs` against `schema`: true where a
+/// document validates. `None` where python3 with jsonschema is missing (a failure in CI,
+/// whose .ci/run installs it).
+fn schema_verdicts(schema: &Path, docs: &[Value]) -> Option<Vec<bool>> {
+    const SCRIPT: &str = r#"
+import json, sys, jsonschema
+schema = json.load(open(sys.argv[1]))
+jsonschema.Draft202012Validator.check_schema(schema)
+v = jsonschema.Draft202012Validator(schema)
+print(json.dumps([v.is_valid(d) for d in json.load(sys.stdin)]))
+"#;
+    let mut child = Command::new("python3")
+        .args(["-c", SCRIPT])
+        .arg(schema)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .ok()?;
+    use std::io::Write;
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(serde_json::to_string(docs).unwrap().as_bytes())
+        .unwrap();
+    let out = child.wait_with_output().ok()?;
+    if !out.status.success() {
+        let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !ci || !err.contains("No module named"),
+            "python3 with jsonschema is required in CI (.ci/run installs it)"
+        );
+        assert!(err.contains("No module named"), "the schema check failed: {err}");
+        eprintln!("SKIPPED: python3 with the jsonschema package is not available (pip install jsonschema)");
+        return None;
+    }
+    Some(serde_json::from_slice(&out.stdout).unwrap())
+}
+
+/// The files of the protocol and its JSON Schemas (studies/protocol/) agree both ways: the
+/// case and result files igimp writes validate, and each of a dozen broken result files is
+/// refused by the schema and by the harness's strict reader alike. The rules that need the
+/// case (one entry per point) are the harness's alone, and it refuses them.
+#[test]
+fn protocol_files_and_the_json_schemas_agree_both_ways() {
+    use igimp::study::external::protocol::{CaseFile, ResultFile};
+    let dir = tempfile::tempdir().unwrap();
+    let file = with_ext_igimp("scene-platen", "schema-platen", dir.path());
+    let out = study(dir.path(), &file, &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let folder = dir.path().join("out/schema-platen/external");
+    let case_dir = std::fs::read_dir(&folder)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let read = |f: &str| -> String { std::fs::read_to_string(case_dir.join(f)).unwrap() };
+    let case_text = read("case.json");
+    let case: CaseFile = serde_json::from_str(&case_text).unwrap();
+    let case_json: Value = serde_json::from_str(&case_text).unwrap();
+    let result: Value = serde_json::from_str(&read("result.json")).unwrap();
+    assert!(ResultFile::parse(&result.to_string(), &case).is_ok());
+    let schemas = root().join("studies/protocol");
+    let Some(v) = schema_verdicts(&schemas.join("case.schema.json"), std::slice::from_ref(&case_json)) else {
+        return;
+    };
+    assert_eq!(v, [true], "the case file igimp writes must validate");
+    type Edit = fn(&mut Value);
+    let broken: [(&str, Edit); 12] = [
+        ("protocol", |r| r["protocol"] = "igimp-case".into()),
+        ("converged with a failure", |r| {
+            r["failure"] = serde_json::json!({"step": 1, "reason": "x"})
+        }),
+        ("failed without a failure", |r| r["status"] = "failed".into()),
+        ("a step without iterations", |r| {
+            r["steps"][0].as_object_mut().unwrap().remove("iterations");
+        }),
+        ("a stress of 8 values", |r| {
+            r["fields"]["cauchy"][0].as_array_mut().unwrap().pop();
+        }),
+        ("F and b both", |r| {
+            let f = r["fields"]["deformation_gradient"].clone();
+            r["fields"]["left_cauchy_green"] = f;
+        }),
+        ("neither F nor b", |r| {
+            r["fields"]
+                .as_object_mut()
+                .unwrap()
+                .remove("deformation_gradient");
+        }),
+        ("a negative volume", |r| r["fields"]["volume"][0] = (-1.0).into()),
+        ("an unknown key", |r| r["stress_unit"] = "Pa".into()),
+        ("a negative residual", |r| {
+            r["steps"][0]["residuals"][0] = (-1.0).into()
+        }),
+        ("an empty code name", |r| r["code"]["name"] = "".into()),
+        ("a load factor of 0", |r| {
+            r["steps"][0]["load_factor"] = 0.0.into()
+        }),
+    ];
+    let mut docs = vec![result.clone()];
+    for (_, edit) in &broken {
+        let mut r = result.clone();
+        edit(&mut r);
+        docs.push(r);
+    }
+    let verdicts = schema_verdicts(&schemas.join("result.schema.json"), &docs).unwrap();
+    assert!(verdicts[0], "the result file igimp writes must validate");
+    for (k, (what, _)) in broken.iter().enumerate() {
+        assert!(!verdicts[k + 1], "the schema accepts a result with {what}");
+        assert!(
+            ResultFile::parse(&docs[k + 1].to_string(), &case).is_err(),
+            "the harness accepts a result with {what}"
+        );
+    }
+    // One point too few: valid to the schema, which cannot see the case; the harness refuses.
+    let mut short = result.clone();
+    short["fields"]["position"].as_array_mut().unwrap().pop();
+    assert_eq!(
+        schema_verdicts(&schemas.join("result.schema.json"), &[short.clone()]).unwrap(),
+        [true]
+    );
+    let e = ResultFile::parse(&short.to_string(), &case).unwrap_err();
+    assert!(
+        e.contains("fields.position") && e.contains("one per point"),
+        "{e}"
+    );
+}
+
+/// igimp's adapter declares every material point family igimp has, and nothing else.
+#[test]
+fn igimp_adapter_declares_every_family() {
+    let text = std::fs::read_to_string(root().join("examples/adapters/igimp/adapter.toml")).unwrap();
+    let t: toml::Table = text.parse().unwrap();
+    let bases: Vec<&str> = t["supports"]["bases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b.as_str().unwrap())
+        .collect();
+    let families: Vec<&str> = igimp::basis::method::Method::MATERIAL_POINT
+        .iter()
+        .map(|m| m.name())
+        .collect();
+    assert_eq!(bases, families);
+}

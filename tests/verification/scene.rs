@@ -405,3 +405,89 @@ measures = [
         assert!((o.measures[2].value - sigma).abs() <= 1e-10 * sigma.abs());
     }
 }
+
+/// The confined column's closed form (reference/README.md item 67) against an independent
+/// derivation, reference/scripts/column_nh.py (its closed form agrees with Gauss–Legendre
+/// quadrature of ∫ (λ − 1) dZ to 2e-15), for Hencky and Kratos' neo-Hookean law at 2 % and
+/// 17 % compression, to 1e-12; and its Hencky form equals the column kind's (eq 44) to 1e-12.
+#[test]
+fn the_confined_column_closed_form_matches_its_independent_derivation() {
+    let column = |model: &str, nu: f64, g: f64| {
+        let m = Material::new(model, &[("young_modulus", 1e6), ("poisson_ratio", nu)]).unwrap();
+        let text = format!(
+            r#"
+grid = {{ origin = [0.0, 0.0], extent = [2.0, 50.0] }}
+bodies = [{{ name = "strip", box = {{ min = [0.0, 0.0], max = [2.0, 50.0] }}, material = "m", density = 80.0 }}]
+loads = [{{ kind = "gravity", vector = [0.0, {}] }}]
+"#,
+            -g
+        );
+        scene(2, &text, m).column("c").unwrap()
+    };
+    // (model, ν, g, u(L), u(L/2)) printed by the script.
+    let cases = [
+        (
+            "neo-hookean",
+            0.0,
+            10.0,
+            -9.866698648395175e-01,
+            -7.383364315204664e-01,
+        ),
+        (
+            "linear-elastic",
+            0.0,
+            10.0,
+            -9.620085823235978e-01,
+            -7.168792767925332e-01,
+        ),
+        (
+            "neo-hookean",
+            0.3,
+            150.0,
+            -8.693028937865858e+00,
+            -6.249392428271946e+00,
+        ),
+        (
+            "linear-elastic",
+            0.3,
+            150.0,
+            -7.949524617215941e+00,
+            -5.646800948577689e+00,
+        ),
+        (
+            "neo-hookean",
+            0.0,
+            100.0,
+            -8.696968478657773e+00,
+            -6.362649159467323e+00,
+        ),
+    ];
+    for (model, nu, g, top, middle) in cases {
+        let c = column(model, nu, g);
+        for (z, want) in [(50.0, top), (25.0, middle)] {
+            let got = c.displacement(&[1.0, z], 1.0);
+            assert!(
+                (got - want).abs() <= 1e-12 * want.abs(),
+                "{model} ν = {nu}, g = {g}, Z = {z}: {got:e} against {want:e}"
+            );
+        }
+    }
+    // The column kind's Hencky closed form (eq 44; its own derivation, with ν = 0.3: the
+    // column kind's lateral confinement is the same uniaxial strain).
+    let (lambda, mu) = igimp::material::constitutive::lame(1e6, 0.3);
+    let analytic = igimp::problems::column::AnalyticalColumn {
+        lambda,
+        mu,
+        unit_weight: 80.0 * 150.0,
+        length: 50.0,
+        yield_stress: None,
+    };
+    let c = column("linear-elastic", 0.3, 150.0);
+    for z in [50.0, 37.5, 12.0] {
+        let (got, want) = (c.displacement(&[1.0, z], 1.0), analytic.elastic_displacement(z));
+        assert!(
+            (got - want).abs() <= 1e-12 * want.abs(),
+            "Z = {z}: {got:e} against eq 44's {want:e}"
+        );
+    }
+}

@@ -1,5 +1,6 @@
 //! The closed forms a scene's measure can be compared with: the smooth platen on a Hencky
-//! block (reference/README.md item 65).
+//! block (reference/README.md item 65) and the confined column of a Hencky or neo-Hookean
+//! material under its own weight (item 67).
 
 use super::spec::{Components, LoadKind, Reference, Scene};
 use crate::solver::error::InputError;
@@ -131,5 +132,157 @@ impl Platen {
         let (lambda, lateral, _) = self.stretches(t);
         let l = if axis == self.axis { lambda } else { lateral };
         (l - 1.0) * (at[axis] - self.min[axis])
+    }
+}
+
+/// An elastic law under uniaxial strain F = diag(1, …, λ) along the column's axis: the first
+/// Piola stress P(λ) and the stored energy W(λ) per unit reference volume.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum UniaxialLaw {
+    /// Hencky: P = M ln λ / λ, W = M/2 ln²λ, M = λ_L + 2μ.
+    Hencky { lambda: f64, mu: f64 },
+    /// Compressible neo-Hookean (Kratos' law): P = λ_L ln λ / λ + μ (λ − 1/λ),
+    /// W = μ/2 (λ² − 1) − μ ln λ + λ_L/2 ln²λ.
+    NeoHookean { lambda: f64, mu: f64 },
+}
+
+impl UniaxialLaw {
+    pub fn piola(self, s: f64) -> f64 {
+        match self {
+            UniaxialLaw::Hencky { lambda, mu } => (lambda + 2.0 * mu) * s.ln() / s,
+            UniaxialLaw::NeoHookean { lambda, mu } => lambda * s.ln() / s + mu * (s - 1.0 / s),
+        }
+    }
+
+    pub fn energy(self, s: f64) -> f64 {
+        let l = s.ln();
+        match self {
+            UniaxialLaw::Hencky { lambda, mu } => 0.5 * (lambda + 2.0 * mu) * l * l,
+            UniaxialLaw::NeoHookean { lambda, mu } => {
+                0.5 * mu * (s * s - 1.0) - mu * l + 0.5 * lambda * l * l
+            }
+        }
+    }
+
+    /// The stretch λ ≤ 1 at which P(λ) = `p` ≤ 0: P is increasing in y = ln λ for y < 1 (dP/dy
+    /// = M (1 − y) e^−y for Hencky, λ_L (1 − y) e^−y + 2μ cosh y for neo-Hookean), so the root
+    /// is unique; bracketed by doubling, then bisection to the last bit. `None` beyond the
+    /// law's largest compressive stress (Hencky's P is bounded below by −M e at λ = 1/e).
+    pub fn stretch(self, p: f64) -> Option<f64> {
+        if p >= 0.0 {
+            return (p == 0.0).then_some(1.0);
+        }
+        let f = |y: f64| self.piola(y.exp()) - p;
+        let mut lo = -1.0;
+        while f(lo) > 0.0 {
+            lo *= 2.0;
+            if lo < -700.0 {
+                return None;
+            }
+        }
+        // Hencky's P has its minimum at y = −1 (λ = 1/e): past it the root is not the branch
+        // of the loaded column.
+        if matches!(self, UniaxialLaw::Hencky { .. }) && f(-1.0) > 0.0 {
+            return None;
+        }
+        let (mut a, mut b) = (
+            if matches!(self, UniaxialLaw::Hencky { .. }) {
+                -1.0
+            } else {
+                lo
+            },
+            0.0,
+        );
+        for _ in 0..200 {
+            let m = 0.5 * (a + b);
+            if m <= a || m >= b {
+                break;
+            }
+            if f(m) > 0.0 {
+                b = m;
+            } else {
+                a = m;
+            }
+        }
+        Some((0.5 * (a + b)).exp())
+    }
+}
+
+/// A laterally confined elastic column under its own weight (reference/README.md item 67):
+/// uniaxial strain along the gravity's axis, P(λ(Z)) = −ρ₀ g (L − Z) from equilibrium with a
+/// free top, and u(Z) = [G(λ(Z)) − G(λ(0))] / (ρ₀ g), G(λ) = (λ − 1) P(λ) − W(λ) (integrating
+/// ∫₀^Z (λ − 1) dZ' by parts, dZ = P'(λ) dλ / (ρ₀ g)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Column {
+    pub law: UniaxialLaw,
+    pub axis: usize,
+    /// The body's base and height along the axis.
+    pub base: f64,
+    pub height: f64,
+    /// ρ₀ g at full load.
+    pub unit_weight: f64,
+    pub ramp: Ramp,
+}
+
+impl Column {
+    /// The displacement along the axis at `at` (its coordinate along the axis) and load factor
+    /// `t`; NaN past the law's largest compressive stress.
+    pub fn displacement(&self, at: &[f64], t: f64) -> f64 {
+        let w = self.unit_weight * self.ramp.factor(t);
+        if w == 0.0 {
+            return 0.0;
+        }
+        let z = (at[self.axis] - self.base).clamp(0.0, self.height);
+        let g = |z: f64| -> Option<f64> {
+            let s = self.law.stretch(-w * (self.height - z))?;
+            Some((s - 1.0) * self.law.piola(s) - self.law.energy(s))
+        };
+        match (g(z), g(0.0)) {
+            (Some(a), Some(b)) => (a - b) / w,
+            _ => f64::NAN,
+        }
+    }
+}
+
+impl Scene {
+    /// The column of a closed form: a box body under one gravity load along an axis, of a
+    /// Hencky or neo-Hookean material.
+    pub fn column(&self, key: &str) -> Result<Column, InputError> {
+        let (axis, g) = super::spec::column_axis(self).ok_or_else(|| {
+            err(
+                format!("{key}.closed_form"),
+                "column-displacement",
+                "needs one box body under one gravity load along an axis (the column)",
+            )
+        })?;
+        let body = &self.bodies[0];
+        let material = &self.materials[&body.material];
+        let (e, nu) = self.hencky_parameters(key)?;
+        let (lambda, mu) = crate::material::constitutive::lame(e, nu);
+        let law = match material.model() {
+            "linear-elastic" => UniaxialLaw::Hencky { lambda, mu },
+            "neo-hookean" => UniaxialLaw::NeoHookean { lambda, mu },
+            other => {
+                return Err(err(
+                    format!("{key}.closed_form"),
+                    other,
+                    "holds for the linear-elastic (Hencky) and neo-hookean models only",
+                ))
+            }
+        };
+        let bb = body.bounding_box();
+        let ramp = self
+            .loads
+            .iter()
+            .find(|l| l.kind == LoadKind::Gravity)
+            .map_or(Ramp::Linear, |l| l.ramp.clone());
+        Ok(Column {
+            law,
+            axis,
+            base: bb.min[axis],
+            height: bb.max[axis] - bb.min[axis],
+            unit_weight: body.density * g,
+            ramp,
+        })
     }
 }

@@ -135,6 +135,13 @@ impl PointFields {
         }
         let volume: Vec<Vec<f64>> = self.volume.iter().map(|&v| vec![v]).collect();
         rows("volume", &volume, 1)?;
+        if let Some(p) = self.volume.iter().position(|&v| v <= 0.0) {
+            return Err(InputError::new(
+                format!("{key}.volume[{p}]"),
+                self.volume[p],
+                "must be > 0",
+            ));
+        }
         Ok(())
     }
 

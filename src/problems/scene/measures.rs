@@ -15,8 +15,9 @@ pub enum MeasureKind {
     /// The sum of one reaction component over a support's or a displacement load's nodes: the
     /// force they exert on the body.
     Reaction,
-    /// Σ V₀ W(εᵉ) over the points, W = μ εᵉ:εᵉ + λ/2 (tr εᵉ)² (Hencky; needs the material's
-    /// `young_modulus` and `poisson_ratio`).
+    /// Σ V₀ W over the points: W = μ εᵉ:εᵉ + λ/2 (tr εᵉ)² (Hencky, and von Mises' elastic
+    /// part), W = μ/2 (tr b − 3) − μ ln J + λ/2 (ln J)² (neo-Hookean, b = exp 2εᵉ); needs the
+    /// material's `young_modulus` and `poisson_ratio`.
     StrainEnergy,
     /// The column's stress error, eq (46), of a one-box scene under one gravity load along an
     /// axis: Σ_p |σ_p − σ(Z_p)| V₀_p / (ρ g V L) against σ(Z) = −ρ g (L − Z), Z the height above
@@ -73,6 +74,9 @@ pub enum ClosedForm {
     PlatenForce,
     /// The smooth-platen displacement (λ_i − 1)(at_i − min_i) of component i at `at`.
     PlatenDisplacement,
+    /// The confined column's displacement along the gravity's axis at `at`, for a Hencky or
+    /// neo-Hookean body (reference/README.md item 67).
+    ColumnDisplacement,
 }
 
 /// The exact value a measure is compared with.

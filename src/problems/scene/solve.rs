@@ -107,12 +107,20 @@ fn tabled_body_force<const D: usize>(
     }))
 }
 
-/// Hencky stored energy V₀ W(εᵉ) of one point.
-fn energy(state: &PointState, volume0: f64, young: f64, poisson: f64) -> f64 {
-    let mu = young / (2.0 * (1.0 + poisson));
-    let lambda = young * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson));
+/// Stored energy V₀ W of one point: Hencky's in εᵉ (the linear-elastic model and von Mises'
+/// elastic part), or the neo-Hookean one in b = exp 2εᵉ and ln J = tr εᵉ.
+fn energy(state: &PointState, volume0: f64, young: f64, poisson: f64, neo_hookean: bool) -> f64 {
+    let (lambda, mu) = crate::material::constitutive::lame(young, poisson);
     let e = &state.material.eps_e;
-    volume0 * (mu * e.component_mul(e).sum() + 0.5 * lambda * e.trace().powi(2))
+    let w = if neo_hookean {
+        let (l, _) = crate::material::kinematics::sym_eigen(e);
+        let tr_b: f64 = l.iter().map(|x| (2.0 * x).exp()).sum();
+        let ln_j = e.trace();
+        0.5 * mu * (tr_b - 3.0) - mu * ln_j + 0.5 * lambda * ln_j * ln_j
+    } else {
+        mu * e.component_mul(e).sum() + 0.5 * lambda * e.trace().powi(2)
+    };
+    volume0 * w
 }
 
 /// What the measures read from a solver.
@@ -260,8 +268,9 @@ pub(super) fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>)
                 }
                 MeasureKind::StrainEnergy => {
                     let (e, nu) = scene.hencky_parameters("").unwrap_or((f64::NAN, f64::NAN));
+                    let neo = scene.materials[&scene.bodies[0].material].model() == "neo-hookean";
                     let mut sum = 0.0;
-                    (probe.points)(&mut |_, _, v0, state| sum += energy(state, v0, e, nu));
+                    (probe.points)(&mut |_, _, v0, state| sum += energy(state, v0, e, nu, neo));
                     value(sum)
                 }
                 MeasureKind::ColumnStressError => value(column_stress_error(scene, probe.points)),

@@ -333,7 +333,9 @@ impl Scene {
             (None, Some(form)) => {
                 let wanted = match form {
                     ClosedForm::PlatenForce => MeasureKind::Reaction,
-                    ClosedForm::PlatenDisplacement => MeasureKind::Displacement,
+                    ClosedForm::PlatenDisplacement | ClosedForm::ColumnDisplacement => {
+                        MeasureKind::Displacement
+                    }
                 };
                 if m.kind != wanted {
                     return Err(err(
@@ -342,7 +344,36 @@ impl Scene {
                         format!("is a closed form of a {wanted:?} measure"),
                     ));
                 }
-                self.platen(key, r).map(|_| ())
+                if form != ClosedForm::ColumnDisplacement {
+                    return self.platen(key, r).map(|_| ());
+                }
+                let c = self.column(key)?;
+                if m.component
+                    .as_deref()
+                    .map(|n| super::spec::axis_index("", n, self.dimension))
+                    != Some(Ok(c.axis))
+                {
+                    return Err(err(
+                        format!("{key}.closed_form"),
+                        "column-displacement",
+                        format!("is the displacement along the gravity's axis: the measure's component must be {:?}", super::spec::AXES[c.axis]),
+                    ));
+                }
+                if r.body.is_some() || r.load.is_some() {
+                    return Err(err(
+                        key,
+                        "body/load",
+                        "the column's closed form needs no body or load (its one body and gravity)",
+                    ));
+                }
+                if !c.displacement(m.at.as_deref().unwrap_or(&[]), 1.0).is_finite() {
+                    return Err(err(
+                        format!("{key}.closed_form"),
+                        "column-displacement",
+                        "has no solution: the column's weight exceeds the law's largest compressive stress",
+                    ));
+                }
+                Ok(())
             }
             _ => Err(err(
                 key,

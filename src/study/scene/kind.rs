@@ -243,6 +243,10 @@ fn measures(results: &SceneResults) -> SceneMeasures {
         let at = |t: f64| -> Option<f64> {
             match r.closed_form {
                 None => r.value,
+                Some(ClosedForm::ColumnDisplacement) => {
+                    let c = scene.column("").ok()?;
+                    Some(c.displacement(m.at.as_deref()?, t)).filter(|v| v.is_finite())
+                }
                 Some(form) => {
                     let p = scene.platen("", r).ok()?;
                     let axis = m
@@ -251,7 +255,7 @@ fn measures(results: &SceneResults) -> SceneMeasures {
                         .and_then(|c| crate::problems::scene::axis_index("", c, scene.dimension).ok())?;
                     Some(match form {
                         ClosedForm::PlatenForce => p.force(t),
-                        ClosedForm::PlatenDisplacement => p.displacement(m.at.as_deref()?, axis, t),
+                        _ => p.displacement(m.at.as_deref()?, axis, t),
                     })
                 }
             }
