@@ -280,7 +280,10 @@ fn protocol_files_and_the_json_schemas_agree_both_ways() {
     let result: Value = serde_json::from_str(&read("result.json")).unwrap();
     assert!(ResultFile::parse(&result.to_string(), &case).is_ok());
     let schemas = root().join("studies/protocol");
-    let Some(v) = schema_verdicts(&schemas.join("case.schema.json"), std::slice::from_ref(&case_json)) else {
+    let Some(v) = schema_verdicts(
+        &schemas.join("case.schema.json"),
+        std::slice::from_ref(&case_json),
+    ) else {
         return;
     };
     assert_eq!(v, [true], "the case file igimp writes must validate");

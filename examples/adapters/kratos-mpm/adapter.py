@@ -173,6 +173,11 @@ def write_inputs(case, folder):
             "processes_sub_model_part_list": [r[0] for r in regions],
             "pressure_dofs": False,
             "linear_solver_settings": {"solver_type": "sparse_lu"},
+            # Kratos' default 1e-5 puts a point that close to a cell's edge in whichever
+            # neighbour its search meets first; the case's cell is the one holding the point
+            # (reference/README.md item 67).
+            "element_search_settings": {"search_algorithm_type": "bin_based", "max_number_of_results": 1000,
+                                        "searching_tolerance": 1e-12, "remove_entities_not_found": True},
         },
         "processes": {"constraints_process_list": [], "loads_process_list": [], "list_other_processes": []},
         "output_processes": {},
@@ -327,7 +332,15 @@ def solve(case, folder):
                 sim.OutputSolutionStep()
         except RuntimeError as exc:
             loop += time.perf_counter() - t
-            failure = {"step": Analysis.step, "reason": "Kratos: " + str(exc).strip().splitlines()[0][:300]}
+            # Kratos' first line can be a wrapper ("errors occured in a parallel region"):
+            # the message's lines up to its source location say what failed.
+            lines = [ln.strip() for ln in str(exc).strip().splitlines() if ln.strip()]
+            said = []
+            for ln in lines:
+                if ln.startswith("in ") and ":" in ln:
+                    break
+                said.append(ln)
+            failure = {"step": Analysis.step, "reason": "Kratos: " + " / ".join(said or lines[:1])[:400]}
             break
         seconds = time.perf_counter() - t
         loop += seconds
@@ -335,6 +348,10 @@ def solve(case, folder):
         if not converged:
             failure = {"step": Analysis.step, "reason": f"not converged in {case['newton']['max_iterations']} iterations",
                        "residuals": [1.0] + ratios}
+            break
+        if mp.NumberOfElements() != len(order):
+            failure = {"step": Analysis.step, "reason": f"Kratos removed {len(order) - mp.NumberOfElements()} "
+                       "material points its search did not find in the grid"}
             break
         f = fields()
         if any(not math.isfinite(v) for row in f["cauchy"] for v in row):

@@ -263,7 +263,7 @@ pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> Strin
     }
     let fitted: Vec<_> = r.measures.rates.iter().filter(|x| x.slope.is_some()).collect();
     if !fitted.is_empty() {
-        s.push_str("## Fitted rates\n\nSlope of log(error) against log(h) over every converged h of the series (none where an error is at round-off, below 1e-10).\n\n| sweep | measure | series | slope |\n|---|---|---|---:|\n");
+        s.push_str("## Fitted rates\n\nSlope of log(error) against log(h) over every converged h of the series (none where an error is at round-off, below 1e-13).\n\n| sweep | measure | series | slope |\n|---|---|---|---:|\n");
         for x in fitted {
             let ppc = x.points_per_cell.map_or(String::new(), |p| format!(" {p}ppc"));
             let _ = writeln!(
