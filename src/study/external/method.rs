@@ -89,6 +89,19 @@ impl StudyMethod {
         }
     }
 
+    /// True for igimp's finite element comparators.
+    pub fn is_fem(&self) -> bool {
+        self.own().is_some_and(Method::is_fem)
+    }
+
+    /// The human name: igimp's method's, or the study's name of an external one.
+    pub fn label(&self) -> String {
+        match self {
+            StudyMethod::Own(m) => m.label().to_string(),
+            StudyMethod::External(_) => self.name(),
+        }
+    }
+
     pub fn is_external(&self) -> bool {
         matches!(self, StudyMethod::External(_))
     }

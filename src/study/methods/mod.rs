@@ -106,7 +106,7 @@ fn rates(name: &str, r: &Value, out: &mut MethodsResults) {
         let series_cases: Vec<&Value> = ids
             .iter()
             .filter_map(|id| cases.get(id).copied())
-            .filter(|c| method_of(&c["method"]) == Some(method))
+            .filter(|c| method_of(&c["method"]).as_ref() == Some(&method))
             .filter(|c| c["points_per_cell"].as_i64() == ppc || method.is_fem())
             .filter(|c| rate["load"].is_null() || c["load"] == rate["load"])
             .filter(|c| domain_update.is_none() || c["domain_update"].as_str() == domain_update)
@@ -145,7 +145,7 @@ fn rates(name: &str, r: &Value, out: &mut MethodsResults) {
             group: group.clone(),
             measure: measure.to_string(),
             sweep: sweep.to_string(),
-            method,
+            method: method.clone(),
             slope: f(&rate["slope"]),
             levels: levels.clone(),
             expected,
@@ -157,7 +157,7 @@ fn rates(name: &str, r: &Value, out: &mut MethodsResults) {
                     Some(mass) => format!("{sweep}-{}-{mass}-{measure}-rate", method.name()),
                     None => crate::study::manufactured::rate_check_id(
                         sweep,
-                        method,
+                        method.own()?,
                         serde_json::from_value(rate["domain_update"].clone()).ok(),
                         ppc.map(|p| p as usize),
                         measure,
@@ -274,7 +274,7 @@ mod tests {
             .rates
             .iter()
             .filter(|x| x.pass.is_some())
-            .map(|x| (x.sweep.as_str(), x.method, x.pass))
+            .map(|x| (x.sweep.as_str(), x.method.own().unwrap(), x.pass))
             .collect();
         assert_eq!(
             verdicts,

@@ -1,6 +1,6 @@
 //! `<out>/methods/methods.json`'s records, and how they are read out of a study's results.
 
-use crate::basis::method::Method;
+use crate::study::external::StudyMethod as Method;
 use crate::study::results::Software;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;

@@ -2,7 +2,7 @@
 //! study's reference at each element size, and its GCI extrapolation.
 
 use super::records::{f, method_of, Group, MethodsResults, ReferenceRow, MIN_METHODS_PER_FIGURE};
-use crate::basis::method::Method;
+use crate::study::external::StudyMethod as Method;
 use serde_json::Value;
 
 /// A GCI record's (extrapolated value, order, note) for `series` of `sweep`, if any.
@@ -65,7 +65,7 @@ pub(super) fn compaction(name: &str, r: &Value, out: &mut MethodsResults) {
                 .into_iter()
                 .flatten()
                 .filter(|c| ids.contains(&c["id"].as_str().unwrap_or("")))
-                .filter(|c| method_of(&c["method"]) == Some(m))
+                .filter(|c| method_of(&c["method"]) == Some(m.clone()))
                 .collect();
             let Some(ppc) = cs.first().and_then(|c| c["points_per_cell"].as_i64()) else {
                 continue;
@@ -86,7 +86,7 @@ pub(super) fn compaction(name: &str, r: &Value, out: &mut MethodsResults) {
                 study: name.to_string(),
                 sweep: id.to_string(),
                 measure: "max horizontal displacement".into(),
-                method: m,
+                method: m.clone(),
                 reference: what.clone(),
                 ratios: ratios.clone(),
                 extrapolated_ratio: ext.map(|e| e / reference),
@@ -114,10 +114,10 @@ pub(super) fn cantilever(name: &str, r: &Value, out: &mut MethodsResults) {
             .flatten()
             .filter(|x| x["refinement"] == id)
             .collect();
-        let (ext, _, _) = gci_of(r, id, reference.label(), "final u/L");
+        let (ext, _, _) = gci_of(r, id, &reference.label(), "final u/L");
         let finest = rows
             .iter()
-            .filter(|x| method_of(&x["method"]) == Some(reference))
+            .filter(|x| method_of(&x["method"]) == Some(reference.clone()))
             .filter_map(|x| Some((f(&x["element_size"])?, f(&x["u_over_l"])?)))
             .min_by(|a, b| a.0.total_cmp(&b.0));
         let (u_ref, what) = match (ext, finest) {
@@ -141,15 +141,15 @@ pub(super) fn cantilever(name: &str, r: &Value, out: &mut MethodsResults) {
         {
             let ratios: Vec<(f64, f64)> = rows
                 .iter()
-                .filter(|x| method_of(&x["method"]) == Some(m))
+                .filter(|x| method_of(&x["method"]) == Some(m.clone()))
                 .filter_map(|x| Some((f(&x["element_size"])?, f(&x["u_over_l"])? / u_ref)))
                 .collect();
-            let (e, order, note) = gci_of(r, id, m.label(), "final u/L");
+            let (e, order, note) = gci_of(r, id, &m.label(), "final u/L");
             out.references.push(ReferenceRow {
                 study: name.to_string(),
                 sweep: id.to_string(),
                 measure: "final u/L".into(),
-                method: m,
+                method: m.clone(),
                 reference: what.clone(),
                 ratios: ratios.clone(),
                 extrapolated_ratio: e.map(|e| e / u_ref),

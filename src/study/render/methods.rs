@@ -4,6 +4,7 @@
 
 use crate::basis::method::Method;
 use crate::basis::Basis;
+use crate::study::external::StudyMethod;
 use crate::study::methods::{MethodsResults, RateRow};
 use crate::study::render::plot2d::{xy_svg, LegendCorner, XyAxes, XySeries};
 use crate::study::results::read_json;
@@ -19,13 +20,15 @@ pub const RESULTS: &str = "methods.json";
 /// Column order of the tables: the paper's method (iGIMP) first, then the other material point
 /// families in their declaration order ([`Basis::ALL`]), then the finite elements by name — so
 /// a new family takes its column without a line here.
-fn order(m: &Method) -> (usize, String) {
-    let rank = match m {
-        _ if *m == Method::IGIMP => 0,
-        Method::MaterialPoint(b) => 1 + Basis::ALL.iter().position(|x| x == b).unwrap_or(0),
-        Method::Fem(_) => 1 + Basis::ALL.len(),
+fn order(m: &StudyMethod) -> (usize, String) {
+    let rank = match m.own() {
+        Some(Method::IGIMP) => 0,
+        Some(Method::MaterialPoint(b)) => 1 + Basis::ALL.iter().position(|x| *x == b).unwrap_or(0),
+        Some(Method::Fem(_)) => 1 + Basis::ALL.len(),
+        // Other codes after igimp's methods.
+        None => 2 + Basis::ALL.len(),
     };
-    (rank, m.name().to_string())
+    (rank, m.name())
 }
 
 fn rate_cell(rows: &[&RateRow]) -> String {
@@ -102,7 +105,7 @@ fn report(r: &MethodsResults, links: &[Option<String>], drawn: &[(String, String
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let mut methods: Vec<Method> = r.rates.iter().map(|x| x.method).collect();
+    let mut methods: Vec<StudyMethod> = r.rates.iter().map(|x| x.method.clone()).collect();
     methods.sort_by_key(order);
     methods.dedup();
     s.push_str("## Fitted rates\n\nLog-log slope of each error against the resolution (elements or cells per side) over the levels its study fits; in brackets the band its study asserts and whether it held. Several values in a cell: the method's sweeps in that group.\n\n| study | measure | group |");
