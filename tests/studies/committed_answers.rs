@@ -21,6 +21,10 @@ const DIAGNOSTICS: &[&str] = &[
     "nonzeros",
     "factor_nonzeros",
     "timing",
+    // An external code's case: its own and its process's wall seconds.
+    "seconds",
+    "process_seconds",
+    "phases",
 ];
 /// Words of a failure's reason carry numbers of the failing state; its step is compared.
 const TEXT_EXEMPT: &[&str] = &["reason"];
@@ -135,6 +139,21 @@ fn quick_tier_answers_match_the_committed_reports() {
         let quick = read(&quick);
         let committed: std::collections::HashMap<_, _> = cases(&committed).into_iter().collect();
         for (key, case) in cases(&quick) {
+            // An external code that could not be installed here (no registry): its cases are
+            // skipped with a message, except in CI, which installs it.
+            if case["failure"]["reason"]
+                .as_str()
+                .is_some_and(|r| r.contains("the set-up of adapter"))
+            {
+                let ci = std::env::var("CI").is_ok_and(|v| v == "true" || v == "1");
+                assert!(
+                    !ci,
+                    "{name}: {key}: an external code could not be set up in CI: {}",
+                    case["failure"]["reason"]
+                );
+                eprintln!("SKIPPED {name}: {key}: {}", case["failure"]["reason"]);
+                continue;
+            }
             if let Some(c) = committed.get(&key) {
                 compared += 1;
                 let path = format!("{name}: {key}");
