@@ -200,10 +200,18 @@ fn run(argv: &[String], dir: &Path, log: &Path, timeout: Duration) -> Result<(),
         match child.try_wait() {
             Ok(Some(s)) => break s,
             Ok(None) if t.elapsed() > timeout => {
-                // The whole group: a script's own children (a Python under a shell) too.
-                let _ = Command::new("kill")
-                    .args(["-KILL", &format!("-{}", child.id())])
-                    .status();
+                // The whole group: a script's own children (a Python under a shell) too. The
+                // child leads its own group (process_group(0) above), so its pid is the
+                // group's id; the check keeps a bad id from ever naming another group.
+                #[cfg(unix)]
+                if let Ok(pgid) = libc::pid_t::try_from(child.id()) {
+                    if pgid > 1 {
+                        // SAFETY: killpg has no memory effects; it signals the group `pgid`.
+                        unsafe {
+                            libc::killpg(pgid, libc::SIGKILL);
+                        }
+                    }
+                }
                 let _ = child.kill();
                 let _ = child.wait();
                 return Err(format!(

@@ -12,8 +12,15 @@ pub fn external_markdown(r: &SceneResults) -> String {
     if !r.cases.iter().any(|c| c.method.is_external()) {
         return String::new();
     }
-    let mut s = String::from(
-        "## Beside other codes\n\nEvery case, igimp's and the external codes' (studies/PROTOCOL.md). *Solve s* is the code's own measure of its load steps (igimp: the whole case; an external code: its solve loop, import and set-up excluded); *process s* is the adapter process's wall time. Cases run concurrently and share the cores, so times vary from run to run. An external code's residuals are in its own norm where the code says so.\n\n| case | method | code | status | Newton | solve s | ms per iteration | process s | note |\n|---|---|---|---|---:|---:|---:|---:|---|\n",
+    // One thread: the cases ran one after another, each on one thread (an external code too:
+    // its adapter asks for one), so their times compare; otherwise they shared the cores.
+    let concurrency = if r.timing.threads == 1 {
+        "The cases ran one after another, each on one thread (igimp's and the external codes' alike), so their times compare."
+    } else {
+        "Cases ran concurrently and shared the cores, so times vary from run to run; `RAYON_NUM_THREADS=1` runs them one at a time on one thread each."
+    };
+    let mut s = format!(
+        "## Beside other codes\n\nEvery case, igimp's and the external codes' (studies/PROTOCOL.md). *Solve s* is the code's own measure of its load steps (igimp: the whole case; an external code: its solve loop, import and set-up excluded); *process s* is the adapter process's wall time. {concurrency} An external code's residuals are in its own norm where the code says so.\n\n| case | method | code | status | Newton | solve s | ms per iteration | process s | note |\n|---|---|---|---|---:|---:|---:|---:|---|\n",
     );
     for c in &r.cases {
         let ext = c.external.as_ref();
