@@ -113,7 +113,8 @@ pub(super) fn body_mesh<const D: usize, E: ElementFamily<D>>(
         Shape::Box(bx) => {
             let mut n = [0; D];
             for a in 0..D {
-                n[a] = cells(&format!("bodies[0].box (axis {a})"), bx.max[a] - bx.min[a], h)?;
+                n[a] = cells(&format!("bodies[0].box.max[{a}]"), bx.max[a] - bx.min[a], h)
+                    .map_err(|e| side(e, a))?;
             }
             let lo = SVector::<f64, D>::from_iterator(bx.min.iter().copied());
             let hi = SVector::<f64, D>::from_iterator(bx.max.iter().copied());
@@ -194,7 +195,8 @@ pub fn check_resolution(scene: &Scene, s: &SceneSettings, method: Method) -> Res
         // would cost a parse seconds).
         (_, Some(Shape::Box(bx))) if scene.bodies.len() == 1 => {
             for a in 0..d {
-                cells(&format!("bodies[0].box (axis {a})"), bx.max[a] - bx.min[a], h)?;
+                cells(&format!("bodies[0].box.max[{a}]"), bx.max[a] - bx.min[a], h)
+                    .map_err(|e| side(e, a))?;
             }
             lattice_regions(scene, &bx.min, &bx.max, if quadratic { 0.5 * h } else { h }, h)
         }
@@ -267,6 +269,13 @@ fn fem_regions<const D: usize, E: ElementFamily<D>>(
 }
 
 /// Cells of `length` at `h`, which must divide it.
+/// A box side's error, its value the side's length (named by the key of its `max`, which
+/// locates the line).
+fn side(mut e: InputError, axis: usize) -> InputError {
+    e.value = format!("{} (the side max − min along axis {axis})", e.value);
+    e
+}
+
 pub(super) fn cells(key: &str, length: f64, h: f64) -> Result<usize, InputError> {
     let n = length / h;
     if !(n.is_finite()

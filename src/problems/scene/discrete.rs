@@ -308,11 +308,6 @@ impl DiscreteScene {
             .collect()
     }
 
-    /// The reaction of every region after `solver`'s last step, per axis.
-    pub fn reactions<const D: usize>(&self, solver: &MpmSolver<D>) -> super::fields::Reactions {
-        super::fields::reactions(solver, &self.named_dofs())
-    }
-
     /// The material point solver of this scene by `basis` with `s`'s Newton, load steps and
     /// linear solver; the displacement loads prescribed.
     pub fn solver<const D: usize>(

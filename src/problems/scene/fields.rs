@@ -169,9 +169,14 @@ impl PointFields {
     }
 }
 
+/// The reaction of every region of `discrete` after `solver`'s last step, per axis.
+pub fn region_reactions<const D: usize>(discrete: &DiscreteScene, solver: &MpmSolver<D>) -> Reactions {
+    reactions(solver, &discrete.named_dofs())
+}
+
 /// The reaction of every region of `named`: the solver's reactions summed over its fixed
 /// dofs, per axis, in the order the measures sum them.
-pub(super) fn reactions<const D: usize>(solver: &MpmSolver<D>, named: &NamedDofs) -> Reactions {
+fn reactions<const D: usize>(solver: &MpmSolver<D>, named: &NamedDofs) -> Reactions {
     named
         .iter()
         .map(|(name, dofs, _)| {

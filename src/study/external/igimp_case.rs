@@ -5,7 +5,7 @@
 
 use super::protocol::{CaseFile, Code, ResultFile, ResultStep, RunFailure, RunStatus, RunTiming};
 use crate::mpm::MpmSolver;
-use crate::problems::scene::PointFields;
+use crate::problems::scene::{region_reactions, PointFields};
 use crate::solver::load_stepping::{steps_and_failure, LoadStepping};
 use std::path::Path;
 use std::time::Instant;
@@ -84,7 +84,7 @@ fn run<const D: usize>(mut solver: MpmSolver<D>, case: &CaseFile) -> ResultFile 
         if every {
             step_fields.push(PointFields::of_points(&s.points));
         }
-        step_reactions.push(case.scene.reactions(s));
+        step_reactions.push(region_reactions(&case.scene, s));
     });
     let (steps, failure) = steps_and_failure(outcome);
     let fields = (!steps.is_empty()).then(|| PointFields::of_points(&solver.points));
