@@ -1,6 +1,6 @@
 //! igimp's own adapter (`examples/adapters/igimp/`, `study --solve-case`): a case file
 //! solved from its data alone (the grid, points, regions and loads it carries, through
-//! [`DiscreteScene::solver`]) and the result file written. Its results equal the in-process
+//! [`crate::problems::scene::DiscreteScene::solver`]) and the result file written. Its results equal the in-process
 //! run's, which shows that the protocol carries everything a solve needs.
 
 use super::protocol::{CaseFile, Code, ResultFile, ResultStep, RunFailure, RunStatus, RunTiming};
