@@ -132,6 +132,9 @@ pub mod seeded {
         ReferenceGradients = 8,
         /// The effective tangent of a dynamic step without its mass term M/(βΔt²).
         NoMassInTangent = 9,
+        /// Drucker–Prager's apex treated as a smooth part of the cone: the cone's return
+        /// applied past it.
+        DruckerPragerSmoothApex = 10,
     }
 
     static ACTIVE: AtomicU8 = AtomicU8::new(0);

@@ -259,6 +259,22 @@ fn bar_newton_order() -> Result<usize, String> {
     Ok(checks)
 }
 
+/// The largest |f| / c₀ after Drucker–Prager's return from trial states past its apex
+/// (isotropic tension): 0 to round-off when the apex is returned to.
+fn drucker_prager_apex_error() -> f64 {
+    use igimp::material::constitutive::{ConstitutiveModel, DruckerPrager, MaterialState};
+    let m = DruckerPrager::try_new(1e5, 0.3, 50.0, 30.0, 30.0, 0.0).unwrap();
+    let mut worst: f64 = 0.0;
+    for k in 1..=10 {
+        let mut eps = nalgebra::Matrix3::identity() * (1e-3 * k as f64);
+        eps[(0, 1)] = 1e-5;
+        eps[(1, 0)] = 1e-5;
+        let r = m.update(&eps, &MaterialState::default()).unwrap();
+        worst = worst.max(m.yield_function(&r.tau, r.internal.get(0)).abs() / 50.0);
+    }
+    worst
+}
+
 #[test]
 fn every_seeded_bug_is_caught() {
     // The correct kernels pass everything the variants must fail.
@@ -362,6 +378,22 @@ fn every_seeded_bug_is_caught() {
         "a dynamic tangent without its mass term passed the Newton-order check"
     );
     set(Bug::None);
+
+    // 11. Drucker–Prager's apex treated as smooth: the return past the apex leaves the cone
+    //     (tests/verification/drucker_prager.rs checks |f| ≤ 1e-10 c₀ after every return).
+    let right = drucker_prager_apex_error();
+    set(Bug::DruckerPragerSmoothApex);
+    let wrong = drucker_prager_apex_error();
+    set(Bug::None);
+    eprintln!("Drucker–Prager apex as smooth: |f|/c₀ {wrong:.2e} (correct {right:.1e})");
+    assert!(
+        right <= 1e-10,
+        "the correct apex return leaves |f|/c₀ = {right:e}"
+    );
+    assert!(
+        wrong > 1e-3,
+        "a smooth apex passed the yield-surface check: {wrong:e}"
+    );
 
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.
     let wrong = stress_rate(true);

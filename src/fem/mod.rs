@@ -73,17 +73,21 @@ use crate::solver::newton::NewtonSettings;
 use nalgebra::SVector;
 use updated_lagrangian::{fem_advance, fem_step_system, UlCore};
 
-/// The solver of a FEM comparator asked for `requested`: the iterative strategy if asked
-/// for, LDLᵀ otherwise (the symmetric factorisation the comparators' committed answers come
-/// from; their tangents are symmetric).
+/// The solver of a FEM comparator asked for `requested`: the iterative strategy, or a
+/// direct factorisation named, if asked for; otherwise LDLᵀ where the model's tangent is
+/// symmetric (the symmetric factorisation the comparators' committed answers come from) and
+/// LU where it is not (non-associated plasticity: LDLᵀ would read one triangle of an
+/// unsymmetric matrix, and Newton on the compaction in Drucker–Prager with ψ = 5° fell to a
+/// linear rate with it, reference/README.md item 68).
 pub fn comparator_solver(
     requested: crate::solver::linear::LinearSolver,
+    symmetric_tangent: bool,
 ) -> crate::solver::linear::LinearSolver {
     use crate::solver::linear::LinearSolver;
-    if requested == LinearSolver::Iterative {
-        LinearSolver::Iterative
-    } else {
-        LinearSolver::Ldlt
+    match requested {
+        LinearSolver::Auto if symmetric_tangent => LinearSolver::Ldlt,
+        LinearSolver::Auto => LinearSolver::Lu,
+        other => other,
     }
 }
 

@@ -16,6 +16,7 @@ mod hardening_von_mises;
 mod basis;
 mod column;
 mod compaction;
+mod drucker_prager;
 mod dynamics;
 mod elastica;
 mod examples;

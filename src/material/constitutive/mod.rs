@@ -14,11 +14,13 @@
 //! [`registry::BUILT_IN`], or, outside the crate, one [`registry::register`] call
 //! (`examples/hardening_von_mises.rs`).
 
+mod drucker_prager;
 mod linear_elastic;
 mod neo_hookean;
 pub mod registry;
 mod von_mises;
 
+pub use drucker_prager::{DruckerPrager, ENTRY as DRUCKER_PRAGER, EQUIVALENT_PLASTIC_STRAIN};
 pub use linear_elastic::{lame, LinearElastic, ENTRY as LINEAR_ELASTIC};
 pub use neo_hookean::{NeoHookean, ENTRY as NEO_HOOKEAN};
 pub use registry::{Material, ModelEntry, Parameter};
@@ -201,6 +203,13 @@ pub trait ConstitutiveModel: Send + Sync {
     /// (linear elasticity) says no, and the assembly skips the trial strain's spectral
     /// logarithm (three `ln` and a spectral product per point and tangent), passing zeros.
     fn tangent_reads_strain(&self) -> bool {
+        true
+    }
+
+    /// Whether [`Self::tangent`] is symmetric in its pairs (D_ijkl = D_klij) at every state:
+    /// a comparator's direct solver is then LDLᵀ, otherwise LU. Yes by default; a
+    /// non-associated model says no.
+    fn tangent_is_symmetric(&self) -> bool {
         true
     }
 

@@ -53,9 +53,14 @@ pub struct ModelEntry {
     pub build: fn(&Material) -> Result<Box<dyn ConstitutiveModel>, InputError>,
 }
 
-/// The models igimp ships: Hencky elasticity, von Mises perfect plasticity and compressible
-/// neo-Hookean elasticity.
-pub static BUILT_IN: [&ModelEntry; 3] = [&super::LINEAR_ELASTIC, &super::VON_MISES, &super::NEO_HOOKEAN];
+/// The models igimp ships: Hencky elasticity, von Mises perfect plasticity, compressible
+/// neo-Hookean elasticity and Drucker–Prager plasticity.
+pub static BUILT_IN: [&ModelEntry; 4] = [
+    &super::LINEAR_ELASTIC,
+    &super::VON_MISES,
+    &super::NEO_HOOKEAN,
+    &super::DRUCKER_PRAGER,
+];
 
 /// Models added by the program ([`register`]), after the built-in ones.
 static REGISTERED: RwLock<Vec<&'static ModelEntry>> = RwLock::new(Vec::new());

@@ -69,15 +69,16 @@ fn fem_block<const D: usize, E: ElementFamily<D>>(
         gravity,
         nodal_forces: vec![],
     };
+    let model = spec.model()?;
     let settings = PlaneFemSettings {
         gauss_points: None,
         newton: spec.newton,
         load_steps: spec.load_steps,
-        // LDLᵀ unless the spec asks for the iterative solver (its LU default is the material
-        // point methods').
-        linear_solver: crate::fem::comparator_solver(spec.linear_solver),
+        // LDLᵀ for a symmetric tangent unless the spec names a solver (its default is the
+        // material point methods' choice).
+        linear_solver: crate::fem::comparator_solver(spec.linear_solver, model.tangent_is_symmetric()),
     };
-    let fem = ContinuumFem::try_new(mesh, 1.0, spec.model()?, fixed, loads, settings)?;
+    let fem = ContinuumFem::try_new(mesh, 1.0, model, fixed, loads, settings)?;
     Ok((fem, corner))
 }
 

@@ -395,13 +395,13 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     })?;
     let (g, tabled) = gravity::<D>(scene);
     let fixed = fixed_dofs(&named);
+    let model = scene.materials[&body.material].build()?;
     let settings = PlaneFemSettings {
         gauss_points: None,
         newton: s.newton,
         load_steps: s.load_steps,
-        linear_solver: crate::fem::comparator_solver(s.linear_solver),
+        linear_solver: crate::fem::comparator_solver(s.linear_solver, model.tangent_is_symmetric()),
     };
-    let model = scene.materials[&body.material].build()?;
     let loads = FemLoads {
         gravity: g,
         nodal_forces: traction_nodal_forces(scene, &mesh, h)?,
