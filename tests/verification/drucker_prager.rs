@@ -257,3 +257,56 @@ fn newton_is_quadratic_on_a_yielding_drucker_prager_block() {
         }
     }
 }
+
+/// A plane-strain biaxial test on one point (ε_zz = 0, τ_xx held at the confining −σ₃ by
+/// Newton on ε_xx, ε_yy driven in compression): with associated flow, the plane-strain-matched
+/// cone's limit state is Mohr–Coulomb's, τ₁ = τ₃ N_φ + 2c √N_φ, N_φ = (1 + sin φ)/(1 − sin φ)
+/// (de Souza Neto et al. 2008, §8.3.4): reached to 1e-8 relative, for φ = 20° and 30°.
+#[test]
+fn plane_strain_biaxial_limit_is_mohr_coulombs() {
+    use igimp::material::tensor::ij;
+    for phi in [20.0, 30.0] {
+        let m = dp(phi, phi, 0.0);
+        let confining = -100.0;
+        let mut committed = state(0.0);
+        let mut tau = Matrix3::zeros();
+        // An isotropic confinement first, then 300 steps of 1e-4 axial compression.
+        let mut eps_e = Matrix3::identity() * (confining / (3.0 * (E / (3.0 * (1.0 - 0.6)))));
+        for _ in 0..300 {
+            let mut dxx = 0.0;
+            for _ in 0..50 {
+                let mut trial = eps_e;
+                trial[(0, 0)] += dxx;
+                trial[(1, 1)] += -1e-4;
+                let r = m.update(&trial, &committed).unwrap();
+                let residual = r.tau[(0, 0)] - confining;
+                if residual.abs() <= 1e-12 * confining.abs() {
+                    break;
+                }
+                let d = m.tangent(&trial, &committed);
+                dxx -= residual / d[(ij(0, 0), ij(0, 0))];
+            }
+            let mut trial = eps_e;
+            trial[(0, 0)] += dxx;
+            trial[(1, 1)] += -1e-4;
+            let r = m.update(&trial, &committed).unwrap();
+            eps_e = r.eps_e;
+            tau = r.tau;
+            committed.internal = r.internal;
+        }
+        let n_phi = (1.0 + phi.to_radians().sin()) / (1.0 - phi.to_radians().sin());
+        let exact = confining * n_phi - 2.0 * COHESION * n_phi.sqrt();
+        assert!((tau[(0, 0)] - confining).abs() <= 1e-10 * confining.abs());
+        eprintln!(
+            "φ = {phi}: τ_yy {} against {exact}: {:.1e} relative",
+            tau[(1, 1)],
+            (tau[(1, 1)] - exact).abs() / exact.abs()
+        );
+        assert!(
+            (tau[(1, 1)] - exact).abs() <= 1e-8 * exact.abs(),
+            "φ = {phi}: τ_yy = {} against Mohr–Coulomb's {exact} (τ_zz = {})",
+            tau[(1, 1)],
+            tau[(2, 2)]
+        );
+    }
+}
