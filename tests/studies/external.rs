@@ -347,6 +347,22 @@ fn protocol_files_and_the_json_schemas_agree_both_ways() {
         e.contains("fields.position") && e.contains("one per point"),
         "{e}"
     );
+    // A residual history that does not match its iteration count: the harness's to refuse;
+    // none at all is allowed (a code that cannot tell).
+    let mut miscounted = result.clone();
+    miscounted["steps"][0]["residuals"].as_array_mut().unwrap().pop();
+    let e = ResultFile::parse(&miscounted.to_string(), &case).unwrap_err();
+    assert!(
+        e.contains("steps[0].residuals") && e.contains("iterations + 1"),
+        "{e}"
+    );
+    let mut untold = result.clone();
+    for s in untold["steps"].as_array_mut().unwrap() {
+        s.as_object_mut().unwrap().remove("residuals");
+    }
+    assert!(ResultFile::parse(&untold.to_string(), &case).is_ok());
+    let v = schema_verdicts(&schemas.join("result.schema.json"), &[untold]).unwrap();
+    assert_eq!(v, [true]);
 }
 
 /// igimp's adapter declares every material point family igimp has, and nothing else.

@@ -223,11 +223,18 @@ impl ResultFile {
                     format!("{}, must lie in (0, 1]", s.load_factor),
                 ));
             }
-            if s.residuals.is_empty() || s.residuals.iter().any(|r| !(r.is_finite() && *r >= 0.0)) {
+            if !s.residuals.is_empty() && s.residuals.len() != s.iterations + 1 {
                 return Err(refuse(
                     &format!("{key}.residuals"),
-                    "must list at least one finite residual ≥ 0",
+                    format!(
+                        "{} values, must be iterations + 1 = {} (or none)",
+                        s.residuals.len(),
+                        s.iterations + 1
+                    ),
                 ));
+            }
+            if s.residuals.iter().any(|r| !(r.is_finite() && *r >= 0.0)) {
+                return Err(refuse(&format!("{key}.residuals"), "must be finite and ≥ 0"));
             }
             if let Some(t) = s.seconds.filter(|t| !(t.is_finite() && *t >= 0.0)) {
                 return Err(refuse(
