@@ -24,6 +24,12 @@ pub fn unflatten(v: &SVector<f64, 9>) -> Matrix3<f64> {
     Matrix3::from_fn(|i, j| v[ij(i, j)])
 }
 
+/// The deviator `X − (tr X / 3) 1`.
+#[inline]
+pub fn deviator(m: &Matrix3<f64>) -> Matrix3<f64> {
+    m - Matrix3::identity() * (m.trace() / 3.0)
+}
+
 /// `A : X` for a fourth-order `A` and second-order `X`.
 #[inline]
 pub fn contract(a: &Tensor4, x: &Matrix3<f64>) -> Matrix3<f64> {

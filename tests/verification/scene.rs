@@ -35,6 +35,24 @@ fn scene(dimension: usize, toml_text: &str, material: Material) -> Scene {
     s
 }
 
+/// The settings of the small scene tests: h = 1/2, 2 points per cell, `load_steps`, `newton`,
+/// a ghost penalty of `gamma` on cut cells.
+fn small(load_steps: usize, newton: NewtonSettings, gamma: f64) -> SceneSettings {
+    SceneSettings {
+        element_size: 0.5,
+        points_per_cell: 2,
+        load_steps,
+        newton,
+        ghost: GhostSettings {
+            gamma,
+            faces: GhostFaces::Cut,
+            ..Default::default()
+        },
+        domain_update: Default::default(),
+        linear_solver: Default::default(),
+    }
+}
+
 const COMPACTION: &str = r#"
 grid = { origin = [0.0, 0.0], extent = [10.0, 10.0] }
 bodies = [{ name = "block", box = { min = [0.0, 0.0], max = [4.0, 8.0] }, material = "m" }]
@@ -142,23 +160,15 @@ reference = { closed_form = "platen-displacement", body = "block", load = "plate
         .replace("DELTA", &format!("{delta:?}"))
         .replace("component = \"x\"", "component = \"x\"\ndomain_edge = true");
     let s = scene(dimension, &text, Material::linear_elastic(1e5, 0.3));
-    let settings = SceneSettings {
-        element_size: 0.5,
-        points_per_cell: 2,
-        load_steps: steps,
-        newton: NewtonSettings {
+    let settings = small(
+        steps,
+        NewtonSettings {
             residual_norm: ResidualNorm::Total,
             tolerance: 1e-12,
             ..Default::default()
         },
-        ghost: GhostSettings {
-            gamma: 0.0,
-            faces: GhostFaces::Cut,
-            ..Default::default()
-        },
-        domain_update: Default::default(),
-        linear_solver: Default::default(),
-    };
+        0.0,
+    );
     let o = scene::solve(&s, &settings, method).unwrap();
     if o.failure.is_some() {
         println!(
@@ -268,19 +278,7 @@ measures = [{ name = "weight", kind = "reaction", region = "base", component = "
 "#;
     let s = scene(2, text, Material::linear_elastic(1e5, 0.3));
     for method in [Method::IGIMP, Method::CPDI, Method::FEM_Q4, Method::FEM_Q8] {
-        let settings = SceneSettings {
-            element_size: 0.5,
-            points_per_cell: 2,
-            load_steps: 1,
-            newton: NewtonSettings::default(),
-            ghost: GhostSettings {
-                gamma: 1.0,
-                faces: GhostFaces::Cut,
-                ..Default::default()
-            },
-            domain_update: Default::default(),
-            linear_solver: Default::default(),
-        };
+        let settings = small(1, NewtonSettings::default(), 1.0);
         let o = scene::solve(&s, &settings, method).unwrap();
         assert!(o.failure.is_none(), "{method}: {:?}", o.failure);
         // The base carries the weight, density 1 x area 128 x g 10: the masses sum to the area.
@@ -323,22 +321,14 @@ measures = [
     }
     let settle = (0.5 * (lo + hi) - 1.0) * 2.0;
     for &method in scene::methods(2) {
-        let settings = SceneSettings {
-            element_size: 0.5,
-            points_per_cell: 2,
-            load_steps: 2,
-            newton: NewtonSettings {
+        let settings = small(
+            2,
+            NewtonSettings {
                 tolerance: 1e-12,
                 ..Default::default()
             },
-            ghost: GhostSettings {
-                gamma: 0.0,
-                faces: GhostFaces::Cut,
-                ..Default::default()
-            },
-            domain_update: Default::default(),
-            linear_solver: Default::default(),
-        };
+            0.0,
+        );
         let o = scene::solve(&s, &settings, method).unwrap();
         assert!(o.failure.is_none(), "{method}: {:?}", o.failure);
         // The base pushes up with the applied resultant, 2000 over the width 2.
@@ -374,23 +364,15 @@ measures = [
 "#;
     let s = scene(2, text, Material::linear_elastic(1e5, 0.3));
     for &method in scene::methods(2) {
-        let settings = SceneSettings {
-            element_size: 0.5,
-            points_per_cell: 2,
-            load_steps: 1,
-            newton: NewtonSettings {
+        let settings = small(
+            1,
+            NewtonSettings {
                 residual_norm: ResidualNorm::Total,
                 tolerance: 1e-12,
                 ..Default::default()
             },
-            ghost: GhostSettings {
-                gamma: 0.0,
-                faces: GhostFaces::Cut,
-                ..Default::default()
-            },
-            domain_update: Default::default(),
-            linear_solver: Default::default(),
-        };
+            0.0,
+        );
         let o = scene::solve(&s, &settings, method).unwrap();
         assert!(o.failure.is_none(), "{method}: {:?}", o.failure);
         let sigma = o.measures[0].value / (2.0 + o.measures[1].value);

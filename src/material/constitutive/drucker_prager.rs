@@ -4,7 +4,7 @@ use super::{
     ConstitutiveModel, InternalVariable, InternalVariables, MaterialError, MaterialResponse, MaterialState,
     ModelEntry,
 };
-use crate::material::tensor::{identity_outer, identity_sym, outer, Tensor4};
+use crate::material::tensor::{deviator, identity_outer, identity_sym, outer, Tensor4};
 use crate::solver::error::InputError;
 use nalgebra::Matrix3;
 
@@ -95,10 +95,6 @@ fn plane_strain_match(degrees: f64) -> (f64, f64) {
     let t = degrees.to_radians().tan();
     let root = (9.0 + 12.0 * t * t).sqrt();
     (3.0 * t / root, 3.0 / root)
-}
-
-fn deviator(m: &Matrix3<f64>) -> Matrix3<f64> {
-    m - Matrix3::identity() * (m.trace() / 3.0)
 }
 
 /// Which branch a trial state returns to, with its quantities.

@@ -4,7 +4,7 @@ use super::{
     ConstitutiveModel, InternalVariable, InternalVariables, MaterialError, MaterialResponse, MaterialState,
     ModelEntry,
 };
-use crate::material::tensor::{identity_outer, identity_sym, outer, Tensor4};
+use crate::material::tensor::{deviator, identity_outer, identity_sym, outer, Tensor4};
 use crate::solver::error::InputError;
 use nalgebra::Matrix3;
 
@@ -89,10 +89,6 @@ impl VonMises {
         let s = deviator(tau);
         (1.5 * s.norm_squared()).sqrt() - self.yield_stress
     }
-}
-
-fn deviator(m: &Matrix3<f64>) -> Matrix3<f64> {
-    m - Matrix3::identity() * (m.trace() / 3.0)
 }
 
 impl ConstitutiveModel for VonMises {

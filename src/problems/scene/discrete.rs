@@ -136,15 +136,7 @@ impl DiscreteScene {
                 half_length: points.half_length0.iter().map(v).collect(),
             },
             regions: regions_of(&named),
-            gravity: scene
-                .loads
-                .iter()
-                .filter(|l| l.kind == LoadKind::Gravity)
-                .map(|l| GravityLoad {
-                    vector: l.vector.clone().unwrap_or_default(),
-                    ramp: l.ramp.clone(),
-                })
-                .collect(),
+            gravity: gravity_loads(scene),
             point_loads: traction_point_loads(scene, &points, h)
                 .into_iter()
                 .map(|(p, f)| PointLoad {
@@ -341,14 +333,7 @@ impl DiscreteScene {
             );
         }
         let named = self.named_dofs();
-        let mut linear = SVector::<f64, D>::zeros();
-        let mut tabled = vec![];
-        for l in &self.gravity {
-            match l.ramp {
-                Ramp::Linear => linear += at(&l.vector),
-                _ => tabled.push((at(&l.vector), l.ramp.clone())),
-            }
-        }
+        let (linear, tabled) = gravity_split::<D>(&self.gravity, self.density);
         let settings = MpmSettings {
             basis,
             domain_update: s.domain_update,
@@ -367,17 +352,50 @@ impl DiscreteScene {
         };
         let fixed = super::build::fixed_dofs(&named);
         let mut solver = MpmSolver::try_new(grid, points, self.material.build()?, fixed, loads, settings)?;
-        if !tabled.is_empty() {
-            let rho = self.density;
-            solver.set_body_force(BodyForce::new(move |_: &SVector<f64, D>, t: f64| {
-                tabled.iter().map(|(g, r)| g * (rho * r.factor(t))).sum()
-            }));
+        if let Some(b) = tabled {
+            solver.set_body_force(b);
         }
         for (values, ramp) in super::build::prescribed(&named) {
             solver.prescribe(values, ramp.clone())?;
         }
         Ok(solver)
     }
+}
+
+/// The gravity loads of `scene`, in its order.
+pub(super) fn gravity_loads(scene: &Scene) -> Vec<GravityLoad> {
+    scene
+        .loads
+        .iter()
+        .filter(|l| l.kind == LoadKind::Gravity)
+        .map(|l| GravityLoad {
+            vector: l.vector.clone().unwrap_or_default(),
+            ramp: l.ramp.clone(),
+        })
+        .collect()
+}
+
+/// `gravity` as the solvers take it: the sum of the linearly ramped loads (the solvers ramp a
+/// gravity themselves), and the tabled ones as a body force ρ₀ g f(λ) of one density.
+pub(super) fn gravity_split<const D: usize>(
+    gravity: &[GravityLoad],
+    density: f64,
+) -> (SVector<f64, D>, Option<BodyForce<D>>) {
+    let at = |x: &[f64]| SVector::<f64, D>::from_iterator(x.iter().copied());
+    let mut linear = SVector::<f64, D>::zeros();
+    let mut tabled = vec![];
+    for l in gravity {
+        match l.ramp {
+            Ramp::Linear => linear += at(&l.vector),
+            _ => tabled.push((at(&l.vector), l.ramp.clone())),
+        }
+    }
+    let force = (!tabled.is_empty()).then(|| {
+        BodyForce::new(move |_: &SVector<f64, D>, t: f64| {
+            tabled.iter().map(|(g, r)| g * (density * r.factor(t))).sum()
+        })
+    });
+    (linear, force)
 }
 
 /// The regions of `named`, each with its nodes once and its components in order.

@@ -3,16 +3,15 @@
 //! load steps run, and the measures read after every step.
 
 use super::build::{body_mesh, fixed_dofs, prescribed, region_dofs, traction_nodal_forces, NamedDofs};
-use super::spec::{axis_index, LoadKind, MeasureKind, Scene, SceneSettings};
+use super::discrete::{gravity_loads, gravity_split};
+use super::spec::{axis_index, MeasureKind, Scene, SceneSettings};
 use crate::basis::method::Method;
 use crate::basis::Basis;
 use crate::fem::{ContinuumFem, ElementFamily, FemLoads, HexElement, PlaneFemSettings, QuadElement};
 use crate::material::kinematics::PointState;
 use crate::mpm::MpmSolver;
-use crate::solver::dynamics::BodyForce;
 use crate::solver::error::{InputError, SolveError};
 use crate::solver::load_stepping::{steps_and_failure, LoadStepping, StepReport};
-use crate::solver::ramp::Ramp;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
 
@@ -71,40 +70,6 @@ pub fn solve(scene: &Scene, settings: &SceneSettings, method: Method) -> Result<
         (3, Method::FEM_HEX20) => solve_fem::<3, _>(scene, settings, HexElement::Hex20),
         (d, m) => Err(m.unsupported(&format!("a scene in dimension {d}"), methods(d))),
     }
-}
-
-/// The node dofs (node, axis, value) of every support (value 0) and displacement load, by
-/// the name of its region, from the nodes' positions: an error names a region on no node.
-/// Σ of the gravity loads with a linear ramp, and those with a table.
-fn gravity<const D: usize>(scene: &Scene) -> (SVector<f64, D>, Vec<(SVector<f64, D>, Ramp)>) {
-    let mut linear = SVector::<f64, D>::zeros();
-    let mut tabled = vec![];
-    for l in scene.loads.iter().filter(|l| l.kind == LoadKind::Gravity) {
-        let g = SVector::<f64, D>::from_iterator(l.vector.iter().flatten().copied());
-        match l.ramp {
-            Ramp::Linear => linear += g,
-            _ => tabled.push((g, l.ramp.clone())),
-        }
-    }
-    (linear, tabled)
-}
-
-/// The body force ρ₀ g f(t) of the tabled gravity loads, ρ₀ the density of the body holding X.
-fn tabled_body_force<const D: usize>(
-    scene: &Scene,
-    tabled: Vec<(SVector<f64, D>, Ramp)>,
-) -> Option<BodyForce<D>> {
-    if tabled.is_empty() {
-        return None;
-    }
-    let bodies = scene.bodies.clone();
-    Some(BodyForce::new(move |x: &SVector<f64, D>, t: f64| {
-        let rho = bodies
-            .iter()
-            .find(|b| b.contains(x.as_slice(), 1e-12))
-            .map_or(0.0, |b| b.density);
-        tabled.iter().map(|(g, r)| g * (rho * r.factor(t))).sum()
-    }))
 }
 
 /// Stored energy V₀ W of one point: Hencky's in εᵉ (the linear-elastic model and von Mises'
@@ -393,7 +358,8 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
             f(k, x.as_slice())
         }
     })?;
-    let (g, tabled) = gravity::<D>(scene);
+    // One body (the mesh's): its density is every Gauss point's.
+    let (g, tabled) = gravity_split::<D>(&gravity_loads(scene), body.density);
     let fixed = fixed_dofs(&named);
     let model = scene.materials[&body.material].build()?;
     let settings = PlaneFemSettings {
@@ -407,7 +373,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
         nodal_forces: traction_nodal_forces(scene, &mesh, h)?,
     };
     let mut fem = ContinuumFem::try_new(mesh, body.density, model, fixed, loads, settings)?;
-    if let Some(b) = tabled_body_force(scene, tabled) {
+    if let Some(b) = tabled {
         fem.set_body_force(b);
     }
     for (values, ramp) in prescribed(&named) {

@@ -15,7 +15,7 @@ pub use method::{ExternalMethod, StudyMethod};
 use crate::problems::scene::{
     measures_of_fields, DiscreteScene, LoadKind, MeasureValue, Scene, SceneSettings,
 };
-use crate::study::results::{rejection, CaseStatus, FailureRecord, SolveRecord, StepRecord};
+use crate::study::results::{CaseStatus, FailureRecord, SolveRecord, StepRecord};
 use adapter::Adapter;
 use protocol::{CaseFile, NewtonCase, Outputs, ResultFile, RunStatus};
 use serde::{Deserialize, Serialize};
@@ -95,23 +95,22 @@ fn unsupported(adapter: &Adapter, scene: &Scene, discrete: &DiscreteScene, basis
     None
 }
 
-fn failed(reason: String, record: ExternalRecord) -> ExternalSolve {
+/// A case that ended before any result: its record `solve`, nothing measured.
+fn unsolved(solve: SolveRecord, record: ExternalRecord) -> ExternalSolve {
     ExternalSolve {
-        solve: SolveRecord {
-            status: CaseStatus::Failed,
-            failure: Some(FailureRecord {
-                step: 0,
-                reason,
-                residuals: vec![],
-            }),
-            newton_iterations: 0,
-            steps: vec![],
-        },
+        solve,
         measures: vec![],
         positions: vec![],
         record,
         points: 0,
     }
+}
+
+/// A case that failed before any step (the adapter, its set-up or its files), with `reason`.
+fn failed(reason: String, record: ExternalRecord) -> ExternalSolve {
+    let mut solve = SolveRecord::rejected(reason);
+    solve.status = CaseStatus::Failed;
+    unsolved(solve, record)
 }
 
 /// Solve case `id` of `scene` by the external `method` with `settings`, its files in
@@ -135,9 +134,7 @@ pub fn solve(
     let discrete = match DiscreteScene::of(scene, settings) {
         Ok(d) => d,
         Err(e) => {
-            let mut f = failed(String::new(), record);
-            f.solve = SolveRecord::rejected(e);
-            return f;
+            return unsolved(SolveRecord::rejected(e), record);
         }
     };
     let basis = method
@@ -146,14 +143,7 @@ pub fn solve(
         .or_else(|| adapter.manifest.supports.bases.first().cloned())
         .unwrap_or_default();
     if let Some(why) = unsupported(&adapter, scene, &discrete, &basis) {
-        let mut f = failed(String::new(), record);
-        f.solve = SolveRecord {
-            status: CaseStatus::Rejected,
-            failure: Some(rejection(format!("unsupported: {why}"))),
-            newton_iterations: 0,
-            steps: vec![],
-        };
-        return f;
+        return unsolved(SolveRecord::rejected(format!("unsupported: {why}")), record);
     }
     let Some(basis_method) = crate::basis::method::Method::from_name(&basis) else {
         return failed(

@@ -113,6 +113,8 @@ impl StudyKind for SceneStudy {
         // The scene is part of every case's definition: editing it re-solves the cases; an
         // external case's, its adapter's manifest too.
         match &c.method {
+            // A case that keeps no positions hashes as it did before positions could be
+            // kept, so its stored records still resume.
             StudyMethod::Own(m) if !c.positions => {
                 CaseKey::of_spec(&c.id, *m, &(&self.scene(), &c.settings), 0)
             }
