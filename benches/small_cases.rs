@@ -94,6 +94,7 @@ fn main() {
                     ghost: spec.ghost,
                     domain_update: spec.domain_update,
                     linear_solver: spec.linear_solver,
+                    f_bar: false,
                 };
                 let (o, cost) = pool.run(|| {
                     scene::solve(&scene, &settings, Method::MaterialPoint(basis)).expect("valid scene")

@@ -135,6 +135,8 @@ pub mod seeded {
         /// Drucker–Prager's apex treated as a smooth part of the cone: the cone's return
         /// applied past it.
         DruckerPragerSmoothApex = 10,
+        /// F-bar's tangent without its F-bar terms: the plain tangent at F̄.
+        FBarWithoutItsTangent = 11,
     }
 
     static ACTIVE: AtomicU8 = AtomicU8::new(0);

@@ -275,6 +275,55 @@ fn drucker_prager_apex_error() -> f64 {
     worst
 }
 
+/// max |K − K_fd| / max |K| of iGIMP with F-bar on the yielding compaction block (von Mises,
+/// σ_y = 2.5e4, h = 1, at its last step), as `tests/verification/fbar.rs` checks it, with
+/// `bug` switched on for the check only (the steps before it are solved correctly).
+fn fbar_tangent_error(bug: Bug) -> f64 {
+    use igimp::material::constitutive::Material;
+    use igimp::problems::compaction::CompactionSpec;
+    use igimp::solver::load_stepping::LoadStepping;
+    use igimp::solver::newton::NonlinearSystem;
+    let spec = CompactionSpec {
+        material: Material::von_mises(1e5, 0.3, 2.5e4),
+        load_steps: 10,
+        f_bar: true,
+        ..Default::default()
+    };
+    let mut solver = spec.mpm_solver().unwrap();
+    for _ in 0..9 {
+        solver.step().unwrap();
+    }
+    set(bug);
+    let err = solver
+        .with_step_system(1.0, |sys| {
+            let n = sys.num_unknowns();
+            let u0: Vec<f64> = (0..n).map(|i| 2e-3 * ((i as f64 * 0.7).sin())).collect();
+            let mut r = vec![0.0; n];
+            sys.evaluate(&u0, &mut r).unwrap();
+            sys.assemble_tangent();
+            let k: Vec<Vec<f64>> = (0..n)
+                .map(|i| (0..n).map(|j| sys.matrix.get(i, j)).collect())
+                .collect();
+            let (h, mut err, mut kmax) = (1e-7, 0.0f64, 0.0f64);
+            let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
+            for j in 0..n {
+                let mut u = u0.clone();
+                u[j] += h;
+                sys.evaluate(&u, &mut rp).unwrap();
+                u[j] -= 2.0 * h;
+                sys.evaluate(&u, &mut rm).unwrap();
+                for i in 0..n {
+                    err = err.max(((rp[i] - rm[i]) / (2.0 * h) - k[i][j]).abs());
+                    kmax = kmax.max(k[i][j].abs());
+                }
+            }
+            err / kmax
+        })
+        .unwrap();
+    set(Bug::None);
+    err
+}
+
 #[test]
 fn every_seeded_bug_is_caught() {
     // The correct kernels pass everything the variants must fail.
@@ -393,6 +442,17 @@ fn every_seeded_bug_is_caught() {
     assert!(
         wrong > 1e-3,
         "a smooth apex passed the yield-surface check: {wrong:e}"
+    );
+
+    // 12. F-bar's tangent without its F-bar terms: the finite-difference check of
+    //     tests/verification/fbar.rs (1e-6) fails.
+    let right = fbar_tangent_error(Bug::None);
+    let wrong = fbar_tangent_error(Bug::FBarWithoutItsTangent);
+    eprintln!("F-bar tangent without its terms: FD error {wrong:.2e} (correct {right:.1e})");
+    assert!(right < 1e-6, "the correct F-bar tangent is off by {right:e}");
+    assert!(
+        wrong > 1e-6,
+        "F-bar's tangent without its terms passed: {wrong:e}"
     );
 
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.

@@ -119,6 +119,7 @@ pub fn time_iteration<const D: usize>(
         linearised: None,
         inertia: None,
         dynamic_reference: None,
+        f_bar: None,
     };
     let u = vec![-1e-4; dofs.len()];
     let mut r = vec![0.0; dofs.len()];

@@ -6,4 +6,5 @@
 pub mod assembly;
 pub mod dofs;
 pub mod ghost;
+pub mod patches;
 pub mod prescribed;

@@ -37,6 +37,10 @@ pub struct PlaneFemSettings {
     /// von Mises problems (the tangent is symmetric) and fall back to LU on failure.
     #[serde(default)]
     pub linear_solver: LinearSolver,
+    /// F-bar: each Gauss point's volume change replaced by its element's average
+    /// ([`crate::discretise::assembly::FBar`]); off by default (reference/README.md item 69).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub f_bar: bool,
 }
 
 impl Default for PlaneFemSettings {
@@ -46,6 +50,7 @@ impl Default for PlaneFemSettings {
             newton: NewtonSettings::default(),
             load_steps: 1,
             linear_solver: LinearSolver::Auto,
+            f_bar: false,
         }
     }
 }
@@ -295,6 +300,7 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
         load_factor: f64,
         f: impl FnOnce(&mut LoadStepSystem<'_, D>) -> R,
     ) -> Result<R, StepFailure> {
+        self.sync_f_bar();
         fem_step_system(
             &mut self.core,
             &self.mesh,
@@ -374,6 +380,18 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
     pub fn system_size(&self) -> (usize, usize) {
         (self.core.work.matrix.dim(), self.core.work.matrix.nnz())
     }
+
+    /// F-bar's patches (each element's Gauss points) as [`PlaneFemSettings::f_bar`] asks.
+    fn sync_f_bar(&mut self) {
+        let work = &mut self.core.work;
+        if self.settings.f_bar != work.patches.is_some() {
+            work.patches = self.settings.f_bar.then(|| {
+                let mut patches = crate::discretise::patches::VolumePatches::default();
+                patches.set(self.gauss.element.iter().copied());
+                patches
+            });
+        }
+    }
 }
 
 impl<const D: usize, E: ElementFamily<D>> LoadStepping for ContinuumFem<D, E> {
@@ -383,6 +401,7 @@ impl<const D: usize, E: ElementFamily<D>> LoadStepping for ContinuumFem<D, E> {
         if self.settings.linear_solver == LinearSolver::Iterative && self.core.work.node_geometry.is_none() {
             self.core.work.node_geometry = Some(crate::solver::multigrid::NodeGeometry::of_mesh(&self.mesh0));
         }
+        self.sync_f_bar();
         fem_advance(
             &mut self.core,
             &mut self.mesh,

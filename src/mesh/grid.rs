@@ -51,6 +51,22 @@ impl<const D: usize> Grid<D> {
         })
     }
 
+    /// The flat index of the cell holding `x` (a point outside, the nearest cell's; on a
+    /// cell face, the upper cell's unless the face is the grid's upper bound).
+    pub fn cell_holding(&self, x: &SVector<f64, D>) -> usize {
+        let mut flat = 0;
+        for a in (0..D).rev() {
+            let t = ((x[a] - self.origin[a]) / self.spacing[a]).floor();
+            let i = if t > 0.0 {
+                (t as usize).min(self.cells[a] - 1)
+            } else {
+                0
+            };
+            flat = flat * self.cells[a] + i;
+        }
+        flat
+    }
+
     /// Coordinates of the lower corner (node 0).
     pub fn origin(&self) -> [f64; D] {
         self.origin

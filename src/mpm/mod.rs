@@ -251,6 +251,13 @@ impl<const D: usize> MpmSolver<D> {
             }
             self.work.table.finish_point();
         }
+        if self.settings.f_bar {
+            let patches = self.work.patches.get_or_insert_with(Default::default);
+            let grid = &self.grid;
+            patches.set(self.points.position.iter().map(|x| grid.cell_holding(x)));
+        } else {
+            self.work.patches = None;
+        }
         Ok(())
     }
 

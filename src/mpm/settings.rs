@@ -43,6 +43,10 @@ pub struct MpmSettings {
     /// `duration`; `None` (default): quasi-static.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dynamics: Option<Newmark>,
+    /// F-bar: each point's volume change replaced by its cell's average
+    /// ([`crate::discretise::assembly::FBar`]); off by default (reference/README.md item 69).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub f_bar: bool,
 }
 
 /// The paper's method: iGIMP (eqs 7–10) with the stretch-tensor domain update (eq 39), the
@@ -62,6 +66,7 @@ impl Default for MpmSettings {
             linear_solver: crate::solver::linear::LinearSolver::default(),
             ghost: GhostSettings::default(),
             dynamics: None,
+            f_bar: false,
         }
     }
 }

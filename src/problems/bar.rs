@@ -252,6 +252,7 @@ impl BarSpec {
             linear_solver: Default::default(),
             ghost: Default::default(),
             dynamics: Some(self.newmark()),
+            f_bar: false,
         };
         let loads = Loads {
             gravity: SVector::zeros(),

@@ -301,6 +301,7 @@ pub fn solve_3d(spec: &ManufacturedSpec, method: Method) -> Result<Solution3, In
                 newton: spec.newton,
                 load_steps: spec.load_steps,
                 linear_solver: LinearSolver::Ldlt,
+                f_bar: false,
             };
             let mut fem = SolidFem::try_new(mesh, 1.0, model()?, fixed, loads, settings)?;
             let (steps, failure) = steps_and_failure(fem.run());

@@ -23,6 +23,7 @@ pub fn single_step_settings(basis: Basis, ghost: GhostSettings) -> MpmSettings {
         linear_solver: Default::default(),
         ghost,
         dynamics: None,
+        f_bar: false,
     }
 }
 

@@ -498,6 +498,7 @@ proptest! {
             length, material: material(young_modulus, poisson_ratio, yield_stress), density, weight,
             elements, points_per_cell, load_steps, newton, gauss_points, ghost: Default::default(),
             dimension,
+            f_bar: false,
         };
         let ok = no_panic("ColumnSpec::validate", || spec.validate())?.is_some();
         let small = elements * points_per_cell <= 64 && load_steps <= 3 && newton.max_iterations <= 40;

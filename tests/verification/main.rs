@@ -22,6 +22,7 @@ mod elastica;
 mod examples;
 mod extreme_values;
 mod families;
+mod fbar;
 mod fem;
 mod fem2d;
 mod fem3d;

@@ -61,6 +61,7 @@ fn patch<const D: usize>(
         linearised: None,
         inertia: None,
         dynamic_reference: None,
+        f_bar: None,
     };
     let mut r = vec![0.0; dofs.len()];
     sys.evaluate(&u, &mut r).unwrap();

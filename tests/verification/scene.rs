@@ -50,6 +50,7 @@ fn small(load_steps: usize, newton: NewtonSettings, gamma: f64) -> SceneSettings
         },
         domain_update: Default::default(),
         linear_solver: Default::default(),
+        f_bar: false,
     }
 }
 
@@ -87,6 +88,7 @@ fn the_compaction_as_a_scene_is_the_compaction() {
                 ghost: spec.ghost,
                 domain_update: spec.domain_update,
                 linear_solver: spec.linear_solver,
+                f_bar: false,
             };
             let o = scene::solve(&s, &settings, method).unwrap();
             assert!(o.failure.is_none());

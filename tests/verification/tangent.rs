@@ -184,6 +184,7 @@ fn assembled_at<const D: usize, R>(
         linearised: None,
         inertia: None,
         dynamic_reference: None,
+        f_bar: None,
     };
     let mut r0 = vec![0.0; n];
     sys.evaluate(&u0, &mut r0).unwrap();

@@ -1,6 +1,7 @@
 //! The point kernels: a point's equations, its spatial gradients (eq 36) and its tangent block
 //! (eq 27), and the runs of points that share equations, scattered by column blocks.
 
+use super::local::{row_stretches, spatial_gradients};
 use crate::discretise::dofs::{DofMap, SupportTable, MAX_POINT_NODES};
 use crate::material::constitutive::ConstitutiveModel;
 use crate::material::kinematics::{PointState, PointTrial};
@@ -25,23 +26,6 @@ pub(super) fn point_equations<const D: usize>(
         }
     }
     nodes.len() * D
-}
-
-/// ∂S/∂x_j = ∂S/∂X̃_i (ΔF⁻¹)_ij (eq 36) of point `p`'s nodes at trial `t` into `gx`; returns
-/// the node count.
-#[inline]
-pub(super) fn spatial_gradients<const D: usize>(
-    table: &SupportTable<D>,
-    p: usize,
-    t: &PointTrial<D>,
-    gx: &mut [SVector<f64, D>; MAX_POINT_NODES],
-) -> usize {
-    let g = table.point(p).2;
-    let inv_t = t.delta_f_inv.transpose();
-    for (x, gk) in gx.iter_mut().zip(g) {
-        *x = inv_t * gk;
-    }
-    g.len()
 }
 
 /// One point's tangent block K_(a i),(b k) = Σ_jl ∂S_a/∂x_j a_ijkl ∂S_b/∂x_l V (eq 27), plus
@@ -130,6 +114,8 @@ pub(super) struct PointKernel<'a, const D: usize> {
     pub(super) states: &'a [PointState],
     pub(super) trials: &'a [Option<PointTrial<D>>],
     pub(super) inertia: Option<Inertia<'a>>,
+    /// The F-bar treatment's patches and q, if on.
+    pub(super) f_bar: Option<super::fbar::FBarView<'a>>,
 }
 
 impl<const D: usize> PointKernel<'_, D> {
@@ -146,7 +132,10 @@ impl<const D: usize> PointKernel<'_, D> {
         let m = spatial_gradients(self.table, p, t, &mut gx);
         let md = m * D;
         kl.resize(md * md, 0.0);
-        let a = t.spatial_tangent(self.model, &self.states[p]);
+        let mut a = t.spatial_tangent(self.model, &self.states[p]);
+        if let Some(f) = &self.f_bar {
+            f.adjust_point_tangent::<D>(p, &mut a);
+        }
         // The inertia term's α m_p S_a S_b δ_ik (consistent mass).
         let mass = self
             .inertia
@@ -279,33 +268,4 @@ fn transpose_square(a: &mut [f64], n: usize) {
             a.swap(c * n + r, r * n + c);
         }
     }
-}
-
-/// Local rows `local..local + len` whose equations are `row..row + len`.
-#[derive(Debug, Clone, Copy)]
-struct RowStretch {
-    local: usize,
-    len: usize,
-    row: usize,
-}
-
-/// A point's equations as stretches of consecutive ones (a node's D dofs, and nodes next to
-/// each other along the first axis), fixed dofs left out.
-fn row_stretches(eqs: &[Option<usize>], out: &mut Vec<RowStretch>) {
-    out.clear();
-    let mut open: Option<RowStretch> = None;
-    for (ri, eq) in eqs.iter().enumerate() {
-        match (*eq, open.as_mut()) {
-            (Some(row), Some(r)) if row == r.row + r.len => r.len += 1,
-            (eq, _) => {
-                out.extend(open.take());
-                open = eq.map(|row| RowStretch {
-                    local: ri,
-                    len: 1,
-                    row,
-                });
-            }
-        }
-    }
-    out.extend(open);
 }

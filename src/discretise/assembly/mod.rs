@@ -8,14 +8,17 @@
 //! a block of columns and add every point's block to them in point order, so results do not
 //! depend on the thread count.
 
+mod fbar;
 mod forces;
 mod kernel;
+mod local;
 mod pattern;
 mod reactions;
 mod system;
 mod workspace;
 
 pub use crate::discretise::dofs::{DofMap, SupportTable, MAX_POINT_NODES};
+pub use fbar::{FBar, FBarScratch};
 pub use forces::map_point_forces;
 pub use reactions::LinearisedReactions;
 pub use system::{DynamicReference, LoadStepSystem};

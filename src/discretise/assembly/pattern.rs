@@ -2,6 +2,7 @@
 
 use crate::discretise::dofs::{DofMap, SupportTable};
 use crate::discretise::ghost::GhostOperator;
+use crate::discretise::patches::VolumePatches;
 
 /// Everything a step's sparsity pattern is a function of: the equation of every nodal dof,
 /// every point's nodes and the ghost faces' nodes. A step whose key equals the last one's has
@@ -15,6 +16,8 @@ pub(crate) struct PatternKey {
     offsets: Vec<usize>,
     nodes: Vec<u32>,
     ghost: Vec<u32>,
+    /// F-bar's patch of every point (empty: off).
+    patches: Vec<usize>,
     /// Set once a key was recorded (an empty table is a key too).
     valid: bool,
 }
@@ -43,9 +46,11 @@ impl PatternKey {
         dofs: &DofMap,
         table: &SupportTable<D>,
         ghost: Option<&GhostOperator<D>>,
+        patches: Option<&VolumePatches>,
     ) -> bool {
         let (offsets, nodes) = table.node_lists();
         self.valid
+            && self.patches == patches.map_or(&[][..], VolumePatches::assignment)
             && self.dofs == *dofs
             && self.offsets == offsets
             && same_numbers(&self.nodes, nodes.iter().copied())
@@ -57,8 +62,12 @@ impl PatternKey {
         dofs: &DofMap,
         table: &SupportTable<D>,
         ghost: Option<&GhostOperator<D>>,
+        patches: Option<&VolumePatches>,
     ) {
         let (offsets, nodes) = table.node_lists();
+        self.patches.clear();
+        self.patches
+            .extend_from_slice(patches.map_or(&[][..], VolumePatches::assignment));
         let narrow = |n: usize| u32::try_from(n).ok();
         self.dofs.clone_from(dofs);
         self.offsets.clear();
@@ -103,17 +112,20 @@ mod tests {
         let before = table([[0, 1], [1, 2]]);
         let dofs = DofMap::build(4, &before, &[], &[]);
         let mut key = PatternKey::default();
-        assert!(!key.matches(&dofs, &before, None), "no key recorded yet");
-        key.record(&dofs, &before, None);
+        assert!(!key.matches(&dofs, &before, None, None), "no key recorded yet");
+        key.record(&dofs, &before, None, None);
         let same = table([[0, 1], [1, 2]]);
         let same_dofs = DofMap::build(4, &same, &[], &[]);
-        assert!(key.matches(&same_dofs, &same, None));
+        assert!(key.matches(&same_dofs, &same, None, None));
         assert_eq!(dofs.pattern(&before), same_dofs.pattern(&same));
         let moved = table([[0, 1], [2, 3]]);
         let moved_dofs = DofMap::build(4, &moved, &[], &[]);
-        assert!(!key.matches(&moved_dofs, &moved, None), "a point changed nodes");
+        assert!(
+            !key.matches(&moved_dofs, &moved, None, None),
+            "a point changed nodes"
+        );
         assert_ne!(dofs.pattern(&before), moved_dofs.pattern(&moved));
         let fixed_dofs = DofMap::build(4, &same, &[(0, 0)], &[]);
-        assert!(!key.matches(&fixed_dofs, &same, None), "node 0 fixed");
+        assert!(!key.matches(&fixed_dofs, &same, None, None), "node 0 fixed");
     }
 }

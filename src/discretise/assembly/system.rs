@@ -2,7 +2,8 @@
 //! inertia term of a dynamic step and the residual norms Newton tests (eqs 22–23).
 
 use super::forces::mass_times;
-use super::kernel::{point_equations, spatial_gradients, PointKernel, MAX_POINT_EQS};
+use super::kernel::{point_equations, PointKernel, MAX_POINT_EQS};
+use super::local::spatial_gradients;
 use super::reactions::LinearisedReactions;
 use crate::discretise::dofs::{DofMap, SupportTable, MAX_POINT_NODES};
 use crate::discretise::ghost::GhostOperator;
@@ -46,6 +47,8 @@ pub struct LoadStepSystem<'a, const D: usize> {
     pub inertia: Option<Inertia<'a>>,
     /// The scale of the convergence test of a dynamic step; `None` (static): f_ext.
     pub dynamic_reference: Option<DynamicReference<'a>>,
+    /// The F-bar treatment ([`super::fbar`]); `None`: off.
+    pub f_bar: Option<super::fbar::FBar<'a>>,
 }
 
 /// What normalises the residual of a dynamic step: √(‖f_ext + M ã‖² + ‖M a₀‖²) over the free
@@ -78,6 +81,11 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         let model = self.model;
         let table = self.table;
         let du = &*self.du_nodal;
+        if let Some(f) = self.f_bar.as_mut() {
+            f.average(table, self.states, du)
+                .map_err(|(point, reason)| StepFailure::Kinematics { point, reason })?;
+        }
+        let f_bar = self.f_bar.as_ref();
         self.trials.resize(self.states.len(), None);
         let first_error = self
             .trials
@@ -86,8 +94,14 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             .enumerate()
             .map(|(p, (slot, state))| {
                 let grad = table.gradient(p, du);
-                match evaluate_point::<D>(model, state, &grad) {
-                    Ok(t) => {
+                // F-bar: the constitutive update sees ΔF̄ = s ΔF; the gradients ∂S/∂x keep
+                // the actual ΔF⁻¹ = s ΔF̄⁻¹.
+                let s = f_bar.map_or(1.0, |f| f.scale(p));
+                match evaluate_point::<D>(model, state, &super::fbar::scaled_gradient(&grad, s)) {
+                    Ok(mut t) => {
+                        if s != 1.0 {
+                            t.delta_f_inv *= s;
+                        }
                         *slot = Some(t);
                         None
                     }
@@ -185,6 +199,10 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             lin.start_tangent(self.fixed_forces);
         }
         let n = self.states.len();
+        if let Some(f) = self.f_bar.as_mut() {
+            f.form_q(self.model, self.states, self.trials);
+        }
+        let f_bar = self.f_bar.as_ref().map(|f| f.view());
         #[cfg(feature = "seeded-bugs")]
         let inertia = self
             .inertia
@@ -198,6 +216,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             states: self.states,
             trials: self.trials,
             inertia,
+            f_bar,
         };
         let runs = kernel.runs(n);
         // Each thread owns a block of columns and walks every run in point order, forming the
@@ -210,9 +229,24 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         self.matrix
             .column_blocks(threads)
             .into_par_iter()
-            .for_each(|mut block| kernel.add_runs(&mut block, runs));
+            .for_each(|mut block| {
+                kernel.add_runs(&mut block, runs);
+                if let Some(f) = &f_bar {
+                    super::fbar::add_patches(f, self.table, self.dofs, self.trials, self.states, &mut block);
+                }
+            });
         if let Some(lin) = self.linearised.as_deref_mut() {
             kernel.linearised_rows(n, lin.rows_mut());
+            if let Some(f) = &f_bar {
+                super::fbar::linearised_rows(
+                    f,
+                    self.table,
+                    self.dofs,
+                    self.trials,
+                    self.states,
+                    lin.rows_mut(),
+                );
+            }
         }
         if let Some(g) = self.ghost {
             g.add_tangent(self.dofs, self.matrix);

@@ -45,6 +45,11 @@ pub struct StepWorkspace<const D: usize> {
     /// What the current pattern was built from, to keep it for a step whose points still
     /// touch the same nodes ([`PatternKey`]).
     pub(crate) pattern_key: PatternKey,
+    /// F-bar's volume patches, filled by the solver before each step; `None`: F-bar off
+    /// ([`super::fbar`]).
+    pub patches: Option<crate::discretise::patches::VolumePatches>,
+    /// F-bar's per-step storage.
+    pub f_bar: super::fbar::FBarScratch,
 }
 
 /// What a load step applies, besides the material model and the committed states.
@@ -129,7 +134,10 @@ impl<const D: usize> StepWorkspace<D> {
         // they touched when the pattern was built.
         let kept = self.matrix.nnz() > 0
             && self.matrix.dim() == dofs.len()
-            && (self.fixed_pattern || self.pattern_key.matches(&dofs, &self.table, input.ghost));
+            && (self.fixed_pattern
+                || self
+                    .pattern_key
+                    .matches(&dofs, &self.table, input.ghost, self.patches.as_ref()));
         if kept {
             self.matrix.clear_values();
             if !self.fixed_pattern {
@@ -143,9 +151,13 @@ impl<const D: usize> StepWorkspace<D> {
             if let Some(g) = input.ghost {
                 g.add_pattern(&dofs, &mut columns);
             }
+            if let Some(p) = &self.patches {
+                p.add_pattern(&dofs, &self.table, &mut columns);
+            }
             self.matrix.set_pattern(columns);
             if !self.fixed_pattern {
-                self.pattern_key.record(&dofs, &self.table, input.ghost);
+                self.pattern_key
+                    .record(&dofs, &self.table, input.ghost, self.patches.as_ref());
             }
             if self.matrix.solver() == crate::solver::linear::LinearSolver::Iterative {
                 if let Some(g) = &self.node_geometry {
@@ -192,6 +204,8 @@ impl<const D: usize> StepWorkspace<D> {
                     linearised: None,
                     inertia: None,
                     dynamic_reference: None,
+                    // At no increment every ΔJ is 1 and F-bar changes nothing.
+                    f_bar: None,
                 };
                 if at_rest.assemble_residual(&mut f_int0).is_ok() {
                     for ((f, fi), fe) in f_ext.iter_mut().zip(&f_int0).zip(&f_ext0) {
@@ -246,6 +260,10 @@ impl<const D: usize> StepWorkspace<D> {
             dynamic_reference: reference.as_ref().map(|(load, start)| DynamicReference {
                 effective_load: load,
                 start_inertia: *start,
+            }),
+            f_bar: self.patches.as_ref().map(|patches| super::fbar::FBar {
+                patches,
+                scratch: &mut self.f_bar,
             }),
         };
         f(&mut system)

@@ -121,7 +121,13 @@ fn fem_settings(spec: &CantileverSpec, gauss_points: Option<usize>) -> PlaneFemS
         gauss_points,
         newton: spec.newton,
         load_steps: spec.load_steps,
-        linear_solver: LinearSolver::Ldlt,
+        // F-bar's tangent is unsymmetric (reference/README.md item 69).
+        linear_solver: if spec.f_bar {
+            LinearSolver::Lu
+        } else {
+            LinearSolver::Ldlt
+        },
+        f_bar: spec.f_bar,
     }
 }
 

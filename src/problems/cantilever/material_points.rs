@@ -24,6 +24,7 @@ impl CantileverSpec {
             linear_solver: Default::default(),
             ghost: self.ghost,
             dynamics: None,
+            f_bar: self.f_bar,
         }
     }
 

@@ -47,6 +47,10 @@ pub struct CantileverSpec {
     /// Not serialised at 2, so 2D case hashes stay what they were.
     #[serde(default = "two", skip_serializing_if = "is_two")]
     pub dimension: usize,
+    /// F-bar over each cell or element ([`crate::discretise::assembly::FBar`]). Not serialised
+    /// when off, so case hashes stay what they were.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub f_bar: bool,
 }
 
 fn two() -> usize {
@@ -85,6 +89,7 @@ impl Default for CantileverSpec {
                 cut_share: 0.0,
             },
             dimension: 2,
+            f_bar: false,
         }
     }
 }

@@ -55,6 +55,7 @@ pub(super) fn solve_fem_3d(
         newton: spec.newton,
         load_steps: spec.load_steps,
         linear_solver: Default::default(),
+        f_bar: false,
     };
     let mut fem = SolidFem::try_new(mesh, spec.density, spec.model()?, fixed, loads, settings)?;
     observer(0, ColumnState::Fem3(&fem));

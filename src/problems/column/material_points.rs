@@ -23,6 +23,7 @@ impl ColumnSpec {
             linear_solver: Default::default(),
             ghost: self.ghost,
             dynamics: None,
+            f_bar: self.f_bar,
         }
     }
 

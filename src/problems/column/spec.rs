@@ -51,6 +51,10 @@ pub struct ColumnSpec {
     /// one cell across (MPM/GIMP only so far).
     #[serde(default = "one", skip_serializing_if = "is_one")]
     pub dimension: usize,
+    /// F-bar over each cell (material points) ([`crate::discretise::assembly::FBar`]). Not serialised
+    /// when off, so case hashes stay what they were.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub f_bar: bool,
 }
 
 fn is_off(g: &GhostSettings) -> bool {
@@ -79,6 +83,7 @@ impl Default for ColumnSpec {
             gauss_points: None,
             ghost: GhostSettings::default(),
             dimension: 1,
+            f_bar: false,
         }
     }
 }

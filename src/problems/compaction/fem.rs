@@ -76,7 +76,11 @@ fn fem_block<const D: usize, E: ElementFamily<D>>(
         load_steps: spec.load_steps,
         // LDLᵀ for a symmetric tangent unless the spec names a solver (its default is the
         // material point methods' choice).
-        linear_solver: crate::fem::comparator_solver(spec.linear_solver, model.tangent_is_symmetric()),
+        linear_solver: crate::fem::comparator_solver(
+            spec.linear_solver,
+            model.tangent_is_symmetric() && !spec.f_bar,
+        ),
+        f_bar: spec.f_bar,
     };
     let fem = ContinuumFem::try_new(mesh, 1.0, model, fixed, loads, settings)?;
     Ok((fem, corner))
@@ -111,14 +115,24 @@ fn run_fem_block<const D: usize, E: ElementFamily<D>>(
 /// 3×3×3, LDLᵀ. The measure is u_x of the node at (half_width, 0, 0).
 pub fn solve_fem_3d(spec: &CompactionSpec, element: HexElement) -> Result<FemOutcome, InputError> {
     spec.validate()?;
+    solve_fem_block(spec, quarter_mesh(spec, element)?)
+}
+
+/// The 3D quarter block's solver ([`solve_fem_3d`]), undeformed, and the measure's node.
+pub fn fem_solver_3d(
+    spec: &CompactionSpec,
+    element: HexElement,
+) -> Result<(crate::fem::SolidFem, usize), InputError> {
+    spec.validate()?;
+    fem_block(spec, quarter_mesh(spec, element)?)
+}
+
+fn quarter_mesh(spec: &CompactionSpec, element: HexElement) -> Result<HexMesh, InputError> {
     let h = spec.element_size;
     let (n, nz) = (
         (spec.half_width / h).round() as usize,
         (spec.height / h).round() as usize,
     );
     let size = SVector::<f64, 3>::new(spec.half_width, spec.half_width, spec.height);
-    solve_fem_block(
-        spec,
-        HexMesh::cuboid(SVector::zeros(), size, [n, n, nz], element)?,
-    )
+    HexMesh::cuboid(SVector::zeros(), size, [n, n, nz], element)
 }

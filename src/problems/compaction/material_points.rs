@@ -24,6 +24,7 @@ impl CompactionSpec {
             linear_solver: self.linear_solver,
             ghost: self.ghost,
             dynamics: None,
+            f_bar: self.f_bar,
         }
     }
 

@@ -16,7 +16,7 @@ mod material_points;
 mod solve;
 mod spec;
 
-pub use fem::{fem_solver, solve_fem, solve_fem_3d, FemOutcome};
+pub use fem::{fem_solver, fem_solver_3d, solve_fem, solve_fem_3d, FemOutcome};
 pub use material_points::{solve_mpm, solve_mpm_3d, CompactionOutcome, Domain3dRecord, DomainRecord};
 pub use solve::{solve, CompactionSolution};
 pub use spec::{methods, CompactionSpec, METHODS, METHODS_3D};

@@ -46,6 +46,10 @@ pub struct CompactionSpec {
     /// 2D case hashes stay what they were.
     #[serde(default = "two", skip_serializing_if = "is_two")]
     pub dimension: usize,
+    /// F-bar over each cell or element ([`crate::discretise::assembly::FBar`]). Not serialised
+    /// when off, so case hashes stay what they were.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub f_bar: bool,
 }
 
 fn two() -> usize {
@@ -82,6 +86,7 @@ impl Default for CompactionSpec {
                 ..Default::default()
             },
             dimension: 2,
+            f_bar: false,
         }
     }
 }

@@ -83,6 +83,7 @@ pub(crate) fn mpm_settings(spec: &ManufacturedSpec, method: Method) -> MpmSettin
         linear_solver: LinearSolver::Auto,
         ghost: Default::default(),
         dynamics: None,
+        f_bar: false,
     }
 }
 
@@ -180,6 +181,7 @@ pub fn fem_solver(spec: &ManufacturedSpec, method: Method) -> Result<PlaneFem, I
         newton: spec.newton,
         load_steps: spec.load_steps,
         linear_solver: LinearSolver::Auto,
+        f_bar: false,
     };
     let model = spec.model()?;
     PlaneFem::try_new(mesh, 1.0, model, fixed, loads, settings)

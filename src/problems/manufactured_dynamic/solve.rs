@@ -92,6 +92,7 @@ fn fem_solver_on<const D: usize, E: ElementFamily<D>>(
         newton: spec.newton,
         load_steps: spec.time_steps(),
         linear_solver,
+        f_bar: false,
     };
     let model = spec.static_spec().model()?;
     let loads = FemLoads {

@@ -345,6 +345,7 @@ impl DiscreteScene {
             linear_solver: s.linear_solver,
             ghost: s.ghost,
             dynamics: None,
+            f_bar: s.f_bar,
         };
         let loads = Loads {
             gravity: linear,

@@ -61,6 +61,10 @@ pub struct Measure {
     /// Also record the value after every load step.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub history: bool,
+    /// A factor the value is multiplied by (e.g. −2/(B c) makes a strip footing's reaction
+    /// its pressure over c); default 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scale: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference: Option<Reference>,
 }

@@ -204,7 +204,7 @@ pub(super) fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>)
                 .as_ref()
                 .and_then(|c| axis_index("", c, scene.dimension).ok())
                 .unwrap_or(0);
-            match m.kind {
+            let reading = match m.kind {
                 MeasureKind::Displacement => value((probe.displacement)(
                     m.at.as_deref().unwrap_or(&[]),
                     axis,
@@ -246,9 +246,19 @@ pub(super) fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>)
                         profile,
                     }
                 }
-            }
+            };
+            scaled(m.scale, reading)
         })
         .collect()
+}
+
+/// `reading` multiplied by `scale` (none: 1, the reading itself).
+fn scaled(scale: Option<f64>, mut reading: Reading) -> Reading {
+    if let Some(s) = scale {
+        reading.value *= s;
+        reading.profile.iter_mut().for_each(|v| *v *= s);
+    }
+    reading
 }
 
 /// The measures after the run, from the readings after each converged step: the final
@@ -366,7 +376,12 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
         gauss_points: None,
         newton: s.newton,
         load_steps: s.load_steps,
-        linear_solver: crate::fem::comparator_solver(s.linear_solver, model.tangent_is_symmetric()),
+        // F-bar's tangent is unsymmetric whatever the model (item 69).
+        linear_solver: crate::fem::comparator_solver(
+            s.linear_solver,
+            model.tangent_is_symmetric() && !s.f_bar,
+        ),
+        f_bar: s.f_bar,
     };
     let loads = FemLoads {
         gravity: g,

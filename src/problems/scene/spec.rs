@@ -524,4 +524,7 @@ pub struct SceneSettings {
     pub ghost: GhostSettings,
     pub domain_update: DomainUpdate,
     pub linear_solver: LinearSolver,
+    /// F-bar over each cell (material points) or element (FEM); reference/README.md item 69.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub f_bar: bool,
 }

@@ -342,11 +342,25 @@ fn checks(results: &SceneResults) -> Vec<CheckRecord> {
     let mut out = vec![];
     for e in &study.expect_reference {
         let r = results.measures.references.get(&e.measure);
-        let cases: Vec<&SceneRecord> = results
+        let mut cases: Vec<&SceneRecord> = results
             .sweep(&e.sweep)
             .into_iter()
             .filter(|c| e.methods.is_empty() || e.methods.contains(&c.method))
             .collect();
+        if e.finest {
+            let finest = |m: &StudyMethod| {
+                cases
+                    .iter()
+                    .filter(|c| &c.method == m)
+                    .map(|c| c.h)
+                    .fold(f64::INFINITY, f64::min)
+            };
+            cases = cases
+                .iter()
+                .copied()
+                .filter(|c| c.h == finest(&c.method))
+                .collect();
+        }
         if cases.is_empty() {
             // The tier does not run the sweep (a full-tier sweep in the quick tier).
             continue;
@@ -366,9 +380,10 @@ fn checks(results: &SceneResults) -> Vec<CheckRecord> {
         out.push(check_at_most(
             &format!("{}-{}-reference", e.sweep, e.measure),
             format!(
-                "{} of {who} in sweep {} within {:e} of its reference (measured: the largest relative error over {} cases{})",
+                "{} of {who} in sweep {}{} within {:e} of its reference (measured: the largest relative error over {} cases{})",
                 e.measure,
                 e.sweep,
+                if e.finest { " at its finest h" } else { "" },
                 e.tolerance,
                 cases.len(),
                 if failed { "; a case did not converge" } else { "" }

@@ -49,6 +49,9 @@ pub struct SceneSweep {
     /// Load steps of this sweep (default: the study's `load_steps`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub load_steps: Option<i64>,
+    /// F-bar for every case (ids gain `-fbar`; reference/README.md item 69).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub f_bar: bool,
     #[serde(default)]
     pub quick: SceneSweepQuick,
 }
@@ -73,6 +76,9 @@ pub struct ReferenceExpectation {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub methods: Vec<StudyMethod>,
     pub tolerance: f64,
+    /// Only each method's finest element size of the sweep.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub finest: bool,
     pub source: String,
 }
 
@@ -284,6 +290,7 @@ impl SceneStudy {
             ghost: self.ghost,
             domain_update: Default::default(),
             linear_solver: s.linear_solver.unwrap_or_default(),
+            f_bar: s.f_bar,
         }
     }
 
@@ -300,6 +307,9 @@ impl SceneStudy {
         }
         if let Some(n) = s.load_steps {
             id.push_str(&format!("-steps{n}"));
+        }
+        if s.f_bar {
+            id.push_str("-fbar");
         }
         match s.linear_solver {
             None | Some(crate::solver::linear::LinearSolver::Auto) => {}

@@ -1,0 +1,338 @@
+//! F-bar: each point's deformation increment with its volume change replaced by its patch's,
+//! ΔF̄_p = (ΔJ̄_c / ΔJ_p)^(1/D) ΔF_p with ΔJ̄_c = Σ_q V_q^n ΔJ_q / Σ_q V_q^n over the points q of
+//! patch c (reference/README.md item 69; Coombs et al. 2018 for material points, de Souza Neto
+//! et al. 1996 for elements). The point carries F̄ (its stress, volume and domain follow it);
+//! only the shape-function gradients ∂S/∂x use the actual ΔF.
+//!
+//! The internal force f_a = Σ_p τ̄_p ∂S_a/∂x V_p^0 linearises to the plain tangent at F̄ plus
+//! Σ_p v̄_p ∂_j S_a q_ij (Ḡ_k − ∂_k S_b), with q = D^alg : I_D / (D J̄) (D^alg = ∂τ/∂ε^e_trial,
+//! I_D the in-plane identity) and Ḡ the patch's gradients averaged with the actual trial
+//! volumes V_q^n ΔJ_q: the derivative of ln ΔJ̄_c. The −q ⊗ I part joins each point's block;
+//! the Ḡ part is a rank-one block r gᵀ per patch over the nodes its points touch.
+
+use super::local::{row_stretches, spatial_gradients};
+use crate::discretise::dofs::{DofMap, SupportTable, MAX_POINT_NODES};
+use crate::discretise::patches::VolumePatches;
+use crate::material::constitutive::ConstitutiveModel;
+use crate::material::kinematics::{PointState, PointTrial};
+use crate::material::tensor::ij;
+use crate::solver::sparse::ColumnBlock;
+use nalgebra::{Matrix3, SMatrix, SVector};
+use rayon::prelude::*;
+
+/// Per-step storage of the F-bar treatment, reused from iteration to iteration.
+#[derive(Debug, Clone, Default)]
+pub struct FBarScratch {
+    /// Each point's actual ΔJ_p = det ΔF_p at the last evaluation.
+    dj: Vec<f64>,
+    /// Each point's scale (ΔJ̄_c / ΔJ_p)^(1/D) at the last evaluation.
+    scale: Vec<f64>,
+    /// Each point's q = D^alg : I_D / (D J̄) at the last tangent.
+    q: Vec<Matrix3<f64>>,
+}
+
+/// The F-bar treatment of a step: its patches and their storage.
+pub struct FBar<'a> {
+    /// The volume patches.
+    pub patches: &'a VolumePatches,
+    /// Storage.
+    pub scratch: &'a mut FBarScratch,
+}
+
+/// Whether the tangent carries its F-bar terms (always, unless a seeded bug removes them).
+#[inline(always)]
+pub(super) fn fbar_terms() -> bool {
+    #[cfg(feature = "seeded-bugs")]
+    if crate::seeded::active(crate::seeded::Bug::FBarWithoutItsTangent) {
+        return false;
+    }
+    true
+}
+
+/// ∂Δu/∂X̃ + I scaled by `s`, less I: the gradient whose ΔF is s ΔF.
+#[inline]
+pub(super) fn scaled_gradient<const D: usize>(grad: &SMatrix<f64, D, D>, s: f64) -> SMatrix<f64, D, D> {
+    if s == 1.0 {
+        return *grad;
+    }
+    let mut g = grad * s;
+    for i in 0..D {
+        g[(i, i)] += s - 1.0;
+    }
+    g
+}
+
+impl FBar<'_> {
+    /// From the nodal increment `du`: every point's actual ΔJ and its scale to its patch's
+    /// averaged volume change. A point whose actual increment inverts it is the error
+    /// (point, reason). A patch of one point keeps its ΔF (scale 1).
+    pub(super) fn average<const D: usize>(
+        &mut self,
+        table: &SupportTable<D>,
+        states: &[PointState],
+        du: &[f64],
+    ) -> Result<(), (usize, String)> {
+        let n = states.len();
+        let scratch = &mut *self.scratch;
+        scratch.dj.resize(n, 1.0);
+        scratch.scale.resize(n, 1.0);
+        scratch.dj.par_iter_mut().enumerate().for_each(|(p, dj)| {
+            let df = crate::material::kinematics::delta_f_from_gradient(&table.gradient(p, du));
+            *dj = df.determinant();
+        });
+        if let Some(p) = scratch.dj.iter().position(|j| !(*j > 0.0 && j.is_finite())) {
+            return Err((
+                p,
+                crate::material::kinematics::PointError::Inverted(scratch.dj[p]).to_string(),
+            ));
+        }
+        let patches = self.patches;
+        let dj = &scratch.dj;
+        let averages: Vec<f64> = (0..patches.count())
+            .into_par_iter()
+            .map(|c| {
+                let points = patches.points(c);
+                let (mut v, mut vj) = (0.0, 0.0);
+                for &q in points {
+                    v += states[q].volume;
+                    vj += states[q].volume * dj[q];
+                }
+                vj / v
+            })
+            .collect();
+        scratch.scale.par_iter_mut().enumerate().for_each(|(p, s)| {
+            let c = patches.of(p);
+            *s = if patches.points(c).len() < 2 {
+                1.0
+            } else {
+                (averages[c] / dj[p]).powf(1.0 / D as f64)
+            };
+        });
+        Ok(())
+    }
+
+    /// Point `p`'s scale at the last [`Self::average`].
+    #[inline]
+    pub(super) fn scale(&self, p: usize) -> f64 {
+        self.scratch.scale[p]
+    }
+
+    /// Every point's q at the trial states of the last evaluation.
+    pub(super) fn form_q<const D: usize>(
+        &mut self,
+        model: &dyn ConstitutiveModel,
+        states: &[PointState],
+        trials: &[Option<PointTrial<D>>],
+    ) {
+        let q = &mut self.scratch.q;
+        q.resize(states.len(), Matrix3::zeros());
+        q.par_iter_mut().enumerate().for_each(|(p, qp)| {
+            let t = trials[p].as_ref().expect("evaluated");
+            let eps = if model.tangent_reads_strain() {
+                t.eps_trial()
+            } else {
+                Matrix3::zeros()
+            };
+            let d_alg = model.tangent(&eps, &states[p].material);
+            let scale = 1.0 / (D as f64 * t.j);
+            *qp = Matrix3::from_fn(|i, j| {
+                if i < D && j < D {
+                    scale * (0..D).map(|m| d_alg[(ij(i, j), ij(m, m))]).sum::<f64>()
+                } else {
+                    0.0
+                }
+            });
+        });
+    }
+
+    /// The views the point kernel and the patch blocks read.
+    pub(super) fn view(&self) -> FBarView<'_> {
+        FBarView {
+            patches: self.patches,
+            dj: &self.scratch.dj,
+            q: &self.scratch.q,
+        }
+    }
+}
+
+/// What the tangent's assembly reads of the F-bar treatment.
+#[derive(Clone, Copy)]
+pub(super) struct FBarView<'a> {
+    pub patches: &'a VolumePatches,
+    dj: &'a [f64],
+    q: &'a [Matrix3<f64>],
+}
+
+/// Most nodes a patch's points touch: a cell's points reach at most 4 nodes per axis beyond
+/// the cell's own in GIMP, CPDI and the cubic B-splines.
+const MAX_PATCH_NODES: usize = 7 * 7 * 7;
+
+impl FBarView<'_> {
+    /// Whether point `p` shares its patch (a patch of one point is plain).
+    #[inline]
+    pub fn shared(&self, p: usize) -> bool {
+        self.patches.points(self.patches.of(p)).len() >= 2
+    }
+
+    /// Subtract q_ij δ_kl from point `p`'s spatial tangent (the −q ⊗ I part).
+    pub fn adjust_point_tangent<const D: usize>(&self, p: usize, a: &mut SMatrix<f64, 9, 9>) {
+        if !self.shared(p) || !fbar_terms() {
+            return;
+        }
+        let q = &self.q[p];
+        for i in 0..D {
+            for j in 0..D {
+                for k in 0..D {
+                    a[(ij(i, j), ij(k, k))] -= q[(i, j)];
+                }
+            }
+        }
+    }
+}
+
+/// One patch's rank-one block r gᵀ, over its nodes' dofs.
+pub(super) struct PatchBlock {
+    nodes: Vec<usize>,
+    eqs: Vec<Option<usize>>,
+    r: Vec<f64>,
+    g: Vec<f64>,
+}
+
+impl PatchBlock {
+    pub fn new() -> Self {
+        Self {
+            nodes: Vec::with_capacity(MAX_PATCH_NODES),
+            eqs: Vec::with_capacity(MAX_PATCH_NODES * 3),
+            r: Vec::with_capacity(MAX_PATCH_NODES * 3),
+            g: Vec::with_capacity(MAX_PATCH_NODES * 3),
+        }
+    }
+
+    /// Patch `c`'s nodes and equations (no values).
+    fn locate<const D: usize>(&mut self, f: &FBarView<'_>, table: &SupportTable<D>, dofs: &DofMap, c: usize) {
+        f.patches.nodes(table, c, &mut self.nodes);
+        self.eqs.clear();
+        for &n in &self.nodes {
+            self.eqs.extend((0..D).map(|a| dofs.eq(n * D + a)));
+        }
+    }
+
+    /// Patch `c`'s r and g at the trial states.
+    fn form<const D: usize>(
+        &mut self,
+        f: &FBarView<'_>,
+        table: &SupportTable<D>,
+        trials: &[Option<PointTrial<D>>],
+        states: &[PointState],
+        c: usize,
+    ) {
+        let md = self.nodes.len() * D;
+        self.r.clear();
+        self.r.resize(md, 0.0);
+        self.g.clear();
+        self.g.resize(md, 0.0);
+        let mut gx = [SVector::<f64, D>::zeros(); MAX_POINT_NODES];
+        let mut weight = 0.0;
+        for &p in f.patches.points(c) {
+            let t = trials[p].as_ref().expect("evaluated");
+            let m = spatial_gradients(table, p, t, &mut gx);
+            let w = states[p].volume * f.dj[p];
+            weight += w;
+            let q = &f.q[p];
+            for (k, &node) in table.point(p).0[..m].iter().enumerate() {
+                let local = self.nodes.binary_search(&node).expect("a patch node") * D;
+                for i in 0..D {
+                    let s: f64 = (0..D).map(|j| gx[k][j] * q[(i, j)]).sum();
+                    self.r[local + i] += t.volume * s;
+                    self.g[local + i] += w * gx[k][i];
+                }
+            }
+        }
+        self.g.iter_mut().for_each(|x| *x /= weight);
+    }
+}
+
+/// Add the patch blocks that reach a column of `block`.
+pub(super) fn add_patches<const D: usize>(
+    f: &FBarView<'_>,
+    table: &SupportTable<D>,
+    dofs: &DofMap,
+    trials: &[Option<PointTrial<D>>],
+    states: &[PointState],
+    block: &mut ColumnBlock<'_>,
+) {
+    if !fbar_terms() {
+        return;
+    }
+    let (lo, hi) = block.columns();
+    let owned = |c: &usize| (lo..hi).contains(c);
+    let mut patch = PatchBlock::new();
+    let mut stretches = Vec::new();
+    for c in 0..f.patches.count() {
+        if f.patches.points(c).len() < 2 {
+            continue;
+        }
+        patch.locate(f, table, dofs, c);
+        if !patch.eqs.iter().flatten().any(owned) {
+            continue;
+        }
+        patch.form(f, table, trials, states, c);
+        // K = r gᵀ; stored by rows the lines are K's rows, so the roles swap.
+        let (line_factor, entries) = if block.by_rows() {
+            (&patch.r, &patch.g)
+        } else {
+            (&patch.g, &patch.r)
+        };
+        row_stretches(&patch.eqs, &mut stretches);
+        for (ci, col) in patch.eqs.iter().enumerate() {
+            let Some(col) = col.filter(owned) else { continue };
+            let factor = line_factor[ci];
+            if factor == 0.0 {
+                continue;
+            }
+            let mut hint = usize::MAX;
+            for s in &stretches {
+                let values = block.stretch_with_hint(s.row, col, s.len, &mut hint);
+                for (x, e) in values.iter_mut().zip(&entries[s.local..s.local + s.len]) {
+                    *x += e * factor;
+                }
+            }
+        }
+    }
+}
+
+/// The patch blocks' entries in the rows of fixed dofs: (dof, column, value).
+pub(super) fn linearised_rows<const D: usize>(
+    f: &FBarView<'_>,
+    table: &SupportTable<D>,
+    dofs: &DofMap,
+    trials: &[Option<PointTrial<D>>],
+    states: &[PointState],
+    rows: &mut Vec<(usize, usize, f64)>,
+) {
+    if !fbar_terms() {
+        return;
+    }
+    let mut patch = PatchBlock::new();
+    for c in 0..f.patches.count() {
+        if f.patches.points(c).len() < 2 {
+            continue;
+        }
+        patch.locate(f, table, dofs, c);
+        if patch.eqs.iter().all(Option::is_some) {
+            continue;
+        }
+        patch.form(f, table, trials, states, c);
+        for (ri, row) in patch.eqs.iter().enumerate() {
+            if row.is_some() {
+                continue;
+            }
+            let dof = patch.nodes[ri / D] * D + ri % D;
+            for (ci, col) in patch.eqs.iter().enumerate() {
+                if let Some(col) = *col {
+                    rows.push((dof, col, patch.r[ri] * patch.g[ci]));
+                }
+            }
+        }
+    }
+}
