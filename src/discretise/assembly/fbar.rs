@@ -10,7 +10,7 @@
 //! volumes V_q^n ΔJ_q: the derivative of ln ΔJ̄_c. The −q ⊗ I part joins each point's block;
 //! the Ḡ part is a rank-one block r gᵀ per patch over the nodes its points touch.
 
-use super::local::{row_stretches, spatial_gradients};
+use super::local::{row_stretches, spatial_gradients, RowStretch};
 use crate::discretise::dofs::{DofMap, SupportTable, MAX_POINT_NODES};
 use crate::discretise::patches::VolumePatches;
 use crate::material::constitutive::ConstitutiveModel;
@@ -29,14 +29,62 @@ pub struct FBarScratch {
     scale: Vec<f64>,
     /// Each point's q = D^alg : I_D / (D J̄) at the last tangent.
     q: Vec<Matrix3<f64>>,
+    /// The step's patch layout: what a patch block's rows and columns are, fixed within a
+    /// step (the supports and equations are), so formed once per step, not per thread and
+    /// iteration.
+    layout: PatchLayout,
+}
+
+/// Per patch of two or more points: its nodes (ascending), their equations (D per node) and
+/// those equations as stretches of consecutive ones, flat.
+#[derive(Debug, Clone, Default)]
+struct PatchLayout {
+    /// Per patch, where its nodes start in `nodes` (and `D` times that in `eqs`); `count + 1`.
+    node_start: Vec<usize>,
+    nodes: Vec<usize>,
+    eqs: Vec<Option<usize>>,
+    stretch_start: Vec<usize>,
+    stretches: Vec<RowStretch>,
+}
+
+impl PatchLayout {
+    fn build<const D: usize>(&mut self, patches: &VolumePatches, table: &SupportTable<D>, dofs: &DofMap) {
+        let (mut union, mut local) = (Vec::new(), Vec::new());
+        self.node_start.clear();
+        self.nodes.clear();
+        self.eqs.clear();
+        self.stretch_start.clear();
+        self.stretches.clear();
+        self.node_start.push(0);
+        self.stretch_start.push(0);
+        for c in 0..patches.count() {
+            if patches.points(c).len() >= 2 {
+                patches.nodes(table, c, &mut union);
+                let first = self.eqs.len();
+                self.nodes.extend_from_slice(&union);
+                for &n in &union {
+                    self.eqs.extend((0..D).map(|a| dofs.eq(n * D + a)));
+                }
+                row_stretches(&self.eqs[first..], &mut local);
+                self.stretches.extend_from_slice(&local);
+            }
+            self.node_start.push(self.nodes.len());
+            self.stretch_start.push(self.stretches.len());
+        }
+    }
+
+    /// Patch `c`'s nodes, equations and row stretches.
+    fn of<const D: usize>(&self, c: usize) -> (&[usize], &[Option<usize>], &[RowStretch]) {
+        let (a, b) = (self.node_start[c], self.node_start[c + 1]);
+        let (s, e) = (self.stretch_start[c], self.stretch_start[c + 1]);
+        (&self.nodes[a..b], &self.eqs[a * D..b * D], &self.stretches[s..e])
+    }
 }
 
 /// The F-bar treatment of a step: its patches and their storage.
 pub struct FBar<'a> {
-    /// The volume patches.
-    pub patches: &'a VolumePatches,
-    /// Storage.
-    pub scratch: &'a mut FBarScratch,
+    patches: &'a VolumePatches,
+    scratch: &'a mut FBarScratch,
 }
 
 /// Whether the tangent carries its F-bar terms (always, unless a seeded bug removes them).
@@ -62,7 +110,19 @@ pub(super) fn scaled_gradient<const D: usize>(grad: &SMatrix<f64, D, D>, s: f64)
     g
 }
 
-impl FBar<'_> {
+impl<'a> FBar<'a> {
+    /// F-bar over `patches` for a step of supports `table` and equations `dofs`, in
+    /// `scratch`: the patches' layout is formed here, once for the step.
+    pub fn new<const D: usize>(
+        patches: &'a VolumePatches,
+        scratch: &'a mut FBarScratch,
+        table: &SupportTable<D>,
+        dofs: &DofMap,
+    ) -> Self {
+        scratch.layout.build(patches, table, dofs);
+        Self { patches, scratch }
+    }
+
     /// From the nodal increment `du`: every point's actual ΔJ and its scale to its patch's
     /// averaged volume change. A point whose actual increment inverts it is the error
     /// (point, reason). A patch of one point keeps its ΔF (scale 1).
@@ -151,6 +211,7 @@ impl FBar<'_> {
             patches: self.patches,
             dj: &self.scratch.dj,
             q: &self.scratch.q,
+            layout: &self.scratch.layout,
         }
     }
 }
@@ -161,6 +222,7 @@ pub(super) struct FBarView<'a> {
     pub patches: &'a VolumePatches,
     dj: &'a [f64],
     q: &'a [Matrix3<f64>],
+    layout: &'a PatchLayout,
 }
 
 /// Most nodes a patch's points touch: a cell's points reach at most 4 nodes per axis beyond
@@ -190,10 +252,8 @@ impl FBarView<'_> {
     }
 }
 
-/// One patch's rank-one block r gᵀ, over its nodes' dofs.
+/// One patch's rank-one block r gᵀ over its nodes' dofs (the layout's order).
 pub(super) struct PatchBlock {
-    nodes: Vec<usize>,
-    eqs: Vec<Option<usize>>,
     r: Vec<f64>,
     g: Vec<f64>,
 }
@@ -201,23 +261,12 @@ pub(super) struct PatchBlock {
 impl PatchBlock {
     pub fn new() -> Self {
         Self {
-            nodes: Vec::with_capacity(MAX_PATCH_NODES),
-            eqs: Vec::with_capacity(MAX_PATCH_NODES * 3),
             r: Vec::with_capacity(MAX_PATCH_NODES * 3),
             g: Vec::with_capacity(MAX_PATCH_NODES * 3),
         }
     }
 
-    /// Patch `c`'s nodes and equations (no values).
-    fn locate<const D: usize>(&mut self, f: &FBarView<'_>, table: &SupportTable<D>, dofs: &DofMap, c: usize) {
-        f.patches.nodes(table, c, &mut self.nodes);
-        self.eqs.clear();
-        for &n in &self.nodes {
-            self.eqs.extend((0..D).map(|a| dofs.eq(n * D + a)));
-        }
-    }
-
-    /// Patch `c`'s r and g at the trial states.
+    /// Patch `c`'s r and g at the trial states, over `nodes` (the patch's, ascending).
     fn form<const D: usize>(
         &mut self,
         f: &FBarView<'_>,
@@ -225,8 +274,9 @@ impl PatchBlock {
         trials: &[Option<PointTrial<D>>],
         states: &[PointState],
         c: usize,
+        nodes: &[usize],
     ) {
-        let md = self.nodes.len() * D;
+        let md = nodes.len() * D;
         self.r.clear();
         self.r.resize(md, 0.0);
         self.g.clear();
@@ -240,7 +290,7 @@ impl PatchBlock {
             weight += w;
             let q = &f.q[p];
             for (k, &node) in table.point(p).0[..m].iter().enumerate() {
-                let local = self.nodes.binary_search(&node).expect("a patch node") * D;
+                let local = nodes.binary_search(&node).expect("a patch node") * D;
                 for i in 0..D {
                     let s: f64 = (0..D).map(|j| gx[k][j] * q[(i, j)]).sum();
                     self.r[local + i] += t.volume * s;
@@ -256,7 +306,6 @@ impl PatchBlock {
 pub(super) fn add_patches<const D: usize>(
     f: &FBarView<'_>,
     table: &SupportTable<D>,
-    dofs: &DofMap,
     trials: &[Option<PointTrial<D>>],
     states: &[PointState],
     block: &mut ColumnBlock<'_>,
@@ -267,31 +316,26 @@ pub(super) fn add_patches<const D: usize>(
     let (lo, hi) = block.columns();
     let owned = |c: &usize| (lo..hi).contains(c);
     let mut patch = PatchBlock::new();
-    let mut stretches = Vec::new();
     for c in 0..f.patches.count() {
-        if f.patches.points(c).len() < 2 {
+        let (nodes, eqs, stretches) = f.layout.of::<D>(c);
+        if nodes.is_empty() || !eqs.iter().flatten().any(owned) {
             continue;
         }
-        patch.locate(f, table, dofs, c);
-        if !patch.eqs.iter().flatten().any(owned) {
-            continue;
-        }
-        patch.form(f, table, trials, states, c);
+        patch.form(f, table, trials, states, c, nodes);
         // K = r gᵀ; stored by rows the lines are K's rows, so the roles swap.
         let (line_factor, entries) = if block.by_rows() {
             (&patch.r, &patch.g)
         } else {
             (&patch.g, &patch.r)
         };
-        row_stretches(&patch.eqs, &mut stretches);
-        for (ci, col) in patch.eqs.iter().enumerate() {
+        for (ci, col) in eqs.iter().enumerate() {
             let Some(col) = col.filter(owned) else { continue };
             let factor = line_factor[ci];
             if factor == 0.0 {
                 continue;
             }
             let mut hint = usize::MAX;
-            for s in &stretches {
+            for s in stretches {
                 let values = block.stretch_with_hint(s.row, col, s.len, &mut hint);
                 for (x, e) in values.iter_mut().zip(&entries[s.local..s.local + s.len]) {
                     *x += e * factor;
@@ -305,7 +349,6 @@ pub(super) fn add_patches<const D: usize>(
 pub(super) fn linearised_rows<const D: usize>(
     f: &FBarView<'_>,
     table: &SupportTable<D>,
-    dofs: &DofMap,
     trials: &[Option<PointTrial<D>>],
     states: &[PointState],
     rows: &mut Vec<(usize, usize, f64)>,
@@ -315,20 +358,17 @@ pub(super) fn linearised_rows<const D: usize>(
     }
     let mut patch = PatchBlock::new();
     for c in 0..f.patches.count() {
-        if f.patches.points(c).len() < 2 {
+        let (nodes, eqs, _) = f.layout.of::<D>(c);
+        if nodes.is_empty() || eqs.iter().all(Option::is_some) {
             continue;
         }
-        patch.locate(f, table, dofs, c);
-        if patch.eqs.iter().all(Option::is_some) {
-            continue;
-        }
-        patch.form(f, table, trials, states, c);
-        for (ri, row) in patch.eqs.iter().enumerate() {
+        patch.form(f, table, trials, states, c, nodes);
+        for (ri, row) in eqs.iter().enumerate() {
             if row.is_some() {
                 continue;
             }
-            let dof = patch.nodes[ri / D] * D + ri % D;
-            for (ci, col) in patch.eqs.iter().enumerate() {
+            let dof = nodes[ri / D] * D + ri % D;
+            for (ci, col) in eqs.iter().enumerate() {
                 if let Some(col) = *col {
                     rows.push((dof, col, patch.r[ri] * patch.g[ci]));
                 }

@@ -232,20 +232,13 @@ impl<const D: usize> LoadStepSystem<'_, D> {
             .for_each(|mut block| {
                 kernel.add_runs(&mut block, runs);
                 if let Some(f) = &f_bar {
-                    super::fbar::add_patches(f, self.table, self.dofs, self.trials, self.states, &mut block);
+                    super::fbar::add_patches(f, self.table, self.trials, self.states, &mut block);
                 }
             });
         if let Some(lin) = self.linearised.as_deref_mut() {
             kernel.linearised_rows(n, lin.rows_mut());
             if let Some(f) = &f_bar {
-                super::fbar::linearised_rows(
-                    f,
-                    self.table,
-                    self.dofs,
-                    self.trials,
-                    self.states,
-                    lin.rows_mut(),
-                );
+                super::fbar::linearised_rows(f, self.table, self.trials, self.states, lin.rows_mut());
             }
         }
         if let Some(g) = self.ghost {

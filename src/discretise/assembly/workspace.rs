@@ -261,10 +261,10 @@ impl<const D: usize> StepWorkspace<D> {
                 effective_load: load,
                 start_inertia: *start,
             }),
-            f_bar: self.patches.as_ref().map(|patches| super::fbar::FBar {
-                patches,
-                scratch: &mut self.f_bar,
-            }),
+            f_bar: self
+                .patches
+                .as_ref()
+                .map(|patches| super::fbar::FBar::new(patches, &mut self.f_bar, &self.table, &dofs)),
         };
         f(&mut system)
     }
