@@ -186,6 +186,7 @@ fn fbar_tangent_matches_central_differences_under_a_footing() {
             domain_update: Default::default(),
             linear_solver: Default::default(),
             f_bar: true,
+            gauss_points: None,
         };
         let discrete = DiscreteScene::of(&scene, &settings).unwrap();
         let mut solver = discrete.solver::<2>(basis, &settings).unwrap();

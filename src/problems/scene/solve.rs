@@ -373,7 +373,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     let fixed = fixed_dofs(&named);
     let model = scene.materials[&body.material].build()?;
     let settings = PlaneFemSettings {
-        gauss_points: None,
+        gauss_points: s.gauss_points,
         newton: s.newton,
         load_steps: s.load_steps,
         // F-bar's tangent is unsymmetric whatever the model (item 69).

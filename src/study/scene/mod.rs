@@ -52,6 +52,10 @@ pub struct SceneSweep {
     /// F-bar for every case (ids gain `-fbar`; reference/README.md item 69).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub f_bar: bool,
+    /// Gauss points per axis of the FEM cases (1..=5; default: the element's own, 2 for
+    /// Q4/Hex8 and 3 for Q8/Hex20); their ids gain `-gp<n>`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gauss_points: Option<i64>,
     #[serde(default)]
     pub quick: SceneSweepQuick,
 }
@@ -291,6 +295,7 @@ impl SceneStudy {
             domain_update: Default::default(),
             linear_solver: s.linear_solver.unwrap_or_default(),
             f_bar: s.f_bar,
+            gauss_points: s.gauss_points.map(|n| n as usize),
         }
     }
 
@@ -310,6 +315,9 @@ impl SceneStudy {
         }
         if s.f_bar {
             id.push_str("-fbar");
+        }
+        if let (Some(n), false) = (s.gauss_points, method.uses_material_points()) {
+            id.push_str(&format!("-gp{n}"));
         }
         match s.linear_solver {
             None | Some(crate::solver::linear::LinearSolver::Auto) => {}

@@ -57,6 +57,9 @@ impl SceneStudy {
         for (i, s) in self.sweeps.iter().enumerate() {
             chk.unique_ident(&format!("sweeps[{i}].id"), &s.id, &mut ids)?;
             chk.text(&format!("sweeps[{i}].title"), &s.title)?;
+            if let Some(n) = s.gauss_points {
+                chk.count(&format!("sweeps[{i}].gauss_points"), n, 1, 5)?;
+            }
             if let Some(n) = s.load_steps {
                 chk.count(&format!("sweeps[{i}].load_steps"), n, 1, 100_000)?;
             }
