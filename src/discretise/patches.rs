@@ -70,6 +70,13 @@ impl VolumePatches {
         &self.points[self.start[c]..self.start[c + 1]]
     }
 
+    /// Whether patch `c` has two or more points: a patch of one point averages nothing and
+    /// is left plain (no scale, no tangent terms, no couplings).
+    #[inline]
+    pub fn is_shared(&self, c: usize) -> bool {
+        self.points(c).len() >= 2
+    }
+
     /// Every point's patch, for the pattern's key.
     pub fn assignment(&self) -> &[usize] {
         &self.of_point
@@ -95,7 +102,7 @@ impl VolumePatches {
     ) {
         let (mut nodes, mut eqs) = (Vec::new(), Vec::new());
         for c in 0..self.count() {
-            if self.points(c).len() < 2 {
+            if !self.is_shared(c) {
                 continue; // one point: its own support, already coupled
             }
             self.nodes(table, c, &mut nodes);

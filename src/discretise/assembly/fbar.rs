@@ -27,6 +27,8 @@ pub struct FBarScratch {
     dj: Vec<f64>,
     /// Each point's scale (ΔJ̄_c / ΔJ_p)^(1/D) at the last evaluation.
     scale: Vec<f64>,
+    /// Each patch's ΔJ̄_c at the last evaluation.
+    patch_dj: Vec<f64>,
     /// Each point's q = D^alg : I_D / (D J̄) at the last tangent.
     q: Vec<Matrix3<f64>>,
     /// The step's patch layout: what a patch block's rows and columns are, fixed within a
@@ -58,7 +60,7 @@ impl PatchLayout {
         self.node_start.push(0);
         self.stretch_start.push(0);
         for c in 0..patches.count() {
-            if patches.points(c).len() >= 2 {
+            if patches.is_shared(c) {
                 patches.nodes(table, c, &mut union);
                 let first = self.eqs.len();
                 self.nodes.extend_from_slice(&union);
@@ -148,24 +150,26 @@ impl<'a> FBar<'a> {
         }
         let patches = self.patches;
         let dj = &scratch.dj;
-        let averages: Vec<f64> = (0..patches.count())
-            .into_par_iter()
-            .map(|c| {
-                let points = patches.points(c);
+        scratch.patch_dj.resize(patches.count(), 1.0);
+        scratch
+            .patch_dj
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(c, average)| {
                 let (mut v, mut vj) = (0.0, 0.0);
-                for &q in points {
+                for &q in patches.points(c) {
                     v += states[q].volume;
                     vj += states[q].volume * dj[q];
                 }
-                vj / v
-            })
-            .collect();
+                *average = vj / v;
+            });
+        let averages = &scratch.patch_dj;
         scratch.scale.par_iter_mut().enumerate().for_each(|(p, s)| {
             let c = patches.of(p);
-            *s = if patches.points(c).len() < 2 {
-                1.0
-            } else {
+            *s = if patches.is_shared(c) {
                 (averages[c] / dj[p]).powf(1.0 / D as f64)
+            } else {
+                1.0
             };
         });
         Ok(())
@@ -233,7 +237,7 @@ impl FBarView<'_> {
     /// Whether point `p` shares its patch (a patch of one point is plain).
     #[inline]
     pub fn shared(&self, p: usize) -> bool {
-        self.patches.points(self.patches.of(p)).len() >= 2
+        self.patches.is_shared(self.patches.of(p))
     }
 
     /// Subtract q_ij δ_kl from point `p`'s spatial tangent (the −q ⊗ I part).
