@@ -7,6 +7,7 @@ pub mod cantilever_dynamic;
 pub mod column;
 pub mod compaction;
 pub mod elastica;
+pub mod element_test;
 pub mod manufactured;
 pub mod manufactured3d;
 pub mod manufactured_dynamic;

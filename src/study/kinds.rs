@@ -8,6 +8,7 @@ use crate::study::cantilever::CantileverStudy;
 use crate::study::column::ColumnStudy;
 use crate::study::compaction::CompactionStudy;
 use crate::study::dynamics::DynamicStudy;
+use crate::study::element::ElementStudy;
 use crate::study::engine::{self, RunOptions, StudyKind};
 use crate::study::manufactured::ManufacturedStudy;
 use crate::study::render::{self, IndexEntry, Rendered};
@@ -24,6 +25,7 @@ pub const KINDS: &[Kind] = &[
     Kind::of::<ManufacturedStudy>(render::manufactured::render, render::manufactured::index_entry),
     Kind::of::<DynamicStudy>(render::dynamics::render, render::dynamics::index_entry),
     Kind::of::<SceneStudy>(render::scene::render, render::scene::index_entry),
+    Kind::of::<ElementStudy>(render::element::render, render::element::index_entry),
 ];
 
 /// What `study` asks of one study file.

@@ -19,6 +19,7 @@ pub mod checks;
 pub mod column;
 pub mod compaction;
 pub mod dynamics;
+pub mod element;
 pub mod engine;
 pub mod external;
 pub mod kinds;

@@ -9,6 +9,7 @@ mod committed_answers;
 mod compaction_reference_study;
 mod compaction_study;
 mod defects;
+mod element_study;
 mod external;
 mod figures;
 mod first_contact;

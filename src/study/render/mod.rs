@@ -7,6 +7,7 @@ pub mod cantilever;
 pub mod column;
 pub mod compaction;
 pub mod dynamics;
+pub mod element;
 pub mod external;
 pub mod manufactured;
 pub mod methods;
