@@ -29,7 +29,8 @@ use crate::solver::sparse::{Csr, SparseMatrix};
 use serde::{Deserialize, Serialize};
 
 /// How the Newton systems are solved: one of three sparse factorisations, or the iterative
-/// strategy (multigrid-preconditioned CG, then GMRES, then a factorisation).
+/// strategy (multigrid-preconditioned CG on a symmetric matrix, GMRES on an unsymmetric one
+/// or where CG fails, then a factorisation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LinearSolver {
@@ -49,10 +50,12 @@ pub enum LinearSolver {
     /// Conjugate gradients preconditioned by a geometric multigrid V-cycle on the structured
     /// grid ([`crate::solver::multigrid`]), to the relative tolerance the Newton solver sets from its
     /// residual ([`SparseSystem::set_tolerance`]); needs the equations' positions
-    /// ([`SparseSystem::set_geometry`]). If CG breaks down (a tangent that is not positive
-    /// definite) or does not converge, restarted GMRES with the same multigrid solves the
-    /// system ([`crate::solver::krylov::gmres`]); only if that fails too is it solved by LDLᵀ
-    /// (then LU). Both switches are counted. Written `cg` in study files.
+    /// ([`SparseSystem::set_geometry`]). CG only on a symmetric matrix (to
+    /// [`SYMMETRY_TOLERANCE`]): an unsymmetric one (F-bar, non-associated flow) is solved by
+    /// restarted GMRES with the same multigrid ([`crate::solver::krylov::gmres`]) from the
+    /// start. If CG breaks down (a tangent that is not positive definite) or does not
+    /// converge, GMRES takes over; only if that fails too is the system factorised (LDLᵀ if
+    /// symmetric, else LU). Both switches are counted. Written `cg` in study files.
     #[serde(rename = "cg")]
     Iterative,
 }
@@ -102,7 +105,8 @@ pub struct LinearStats {
     pub rebuilds: usize,
     /// Solves [`LinearSolver::Auto`] made by LDLᵀ (the others by LU).
     pub symmetric_solves: usize,
-    /// Solves that CG could not finish and GMRES took over (iterations of both counted).
+    /// Solves by GMRES: every solve of an unsymmetric matrix (CG is for symmetric ones
+    /// only), and the symmetric ones CG could not finish (iterations of both counted).
     pub gmres_solves: usize,
 }
 
@@ -240,14 +244,33 @@ impl SparseSystem {
     fn solve_cg(&mut self, b: &[f64], x: &mut [f64]) -> Result<(), SolverError> {
         // Taken out for the solve so that the strategy's state can change beside it; stored
         // by rows ([`Self::set_solver`]), it is borrowed as it is, not copied.
+        // CG needs a symmetric operator: an unsymmetric tangent (F-bar, non-associated flow)
+        // goes to GMRES with the same multigrid (reference/README.md item 71).
+        let symmetric = self.is_symmetric();
         let matrix = std::mem::take(&mut self.matrix);
-        let out = self.solve_cg_with(&matrix.csr(), b, x);
+        let out = self.solve_cg_with(&matrix.csr(), b, x, symmetric);
         self.matrix = matrix;
         out
     }
 
     /// [`Self::solve_cg`] with the current matrix in row-compressed form.
-    fn solve_cg_with(&mut self, a: &Csr, b: &[f64], x: &mut [f64]) -> Result<(), SolverError> {
+    fn solve_cg_with(
+        &mut self,
+        a: &Csr,
+        b: &[f64],
+        x: &mut [f64],
+        symmetric: bool,
+    ) -> Result<(), SolverError> {
+        let krylov = |a: &Csr, m: &Hierarchy, b: &[f64], x: &mut [f64], rtol: f64, max: usize| {
+            if symmetric {
+                pcg(a, m, b, x, rtol, max)
+            } else {
+                gmres(a, m, b, x, rtol, max)
+            }
+        };
+        if !symmetric {
+            self.stats.gmres_solves += 1;
+        }
         let rtol = if self.tolerance > 0.0 {
             self.tolerance
         } else {
@@ -257,7 +280,7 @@ impl SparseSystem {
             // Given up once it needs more than the fresh count allows.
             let allowed = (REUSE_FACTOR * *fresh as f64) as usize + 2;
             let start = std::time::Instant::now();
-            let report = pcg(a, m.as_ref(), b, x, rtol, allowed);
+            let report = krylov(a, m.as_ref(), b, x, rtol, allowed);
             self.stats.charge(crate::solver::profile::Phase::Solve, start);
             self.stats.iterations += report.as_ref().map_or(allowed, |r| r.iterations);
             match report {
@@ -273,11 +296,17 @@ impl SparseSystem {
         let m = Hierarchy::build(a, geometry)?;
         self.stats.charge(crate::solver::profile::Phase::Setup, start);
         let start = std::time::Instant::now();
-        let report = pcg(a, &m, b, x, rtol, MAX_CG_ITERATIONS);
+        let first_max = if symmetric {
+            MAX_CG_ITERATIONS
+        } else {
+            MAX_GMRES_ITERATIONS
+        };
+        let report = krylov(a, &m, b, x, rtol, first_max);
         self.stats.charge(crate::solver::profile::Phase::Solve, start);
-        self.stats.iterations += report.as_ref().map_or(MAX_CG_ITERATIONS, |r| r.iterations);
+        self.stats.iterations += report.as_ref().map_or(first_max, |r| r.iterations);
         let report = match report {
             Ok(r) => r,
+            Err(e) if !symmetric => return Err(e),
             Err(cg) => {
                 let start = std::time::Instant::now();
                 let report = gmres(a, &m, b, x, rtol, MAX_GMRES_ITERATIONS);
@@ -368,7 +397,10 @@ impl SparseSystem {
             LinearSolver::Llt => Some(Factorisation::Llt),
             LinearSolver::Auto => self.is_symmetric().then_some(Factorisation::Ldlt),
             // The iterative strategy's last resort is LDLᵀ.
-            LinearSolver::Ldlt | LinearSolver::Iterative => Some(Factorisation::Ldlt),
+            LinearSolver::Ldlt => Some(Factorisation::Ldlt),
+            // The iterative strategy's last resort factorises as Auto does: LDLᵀ would read
+            // one triangle of an unsymmetric tangent.
+            LinearSolver::Iterative => self.is_symmetric().then_some(Factorisation::Ldlt),
         };
         if let Some(kind) = symmetric {
             self.rhs.clear();

@@ -310,3 +310,85 @@ fn cg_iterations_stay_bounded_under_refinement() {
         assert!(it <= 20.0, "h = 1/{n}: {it} iterations per solve");
     }
 }
+
+/// CG only on symmetric tangents: the compaction at h = 1/4 (iGIMP) in Drucker–Prager,
+/// associated (symmetric tangent) and with ψ = 5° (unsymmetric), and in Hencky with F-bar
+/// (unsymmetric). Under `LinearSolver::Iterative` every solve of an unsymmetric tangent is
+/// GMRES with the multigrid and every symmetric one CG (the associated run uses no GMRES, the
+/// others do); each run equals the LU run to the
+/// Newton tolerance, none falls back to a factorisation, and Newton takes the LU run's
+/// iterations in every step (the active set changing makes some steps' early iterations
+/// linear here, with either solver).
+#[test]
+fn unsymmetric_tangents_are_solved_by_gmres_never_cg() {
+    use igimp::material::constitutive::Material;
+    let dp = |psi: f64| {
+        Material::new(
+            "drucker-prager",
+            &[
+                ("young_modulus", 1e5),
+                ("poisson_ratio", 0.3),
+                ("cohesion", 1.2e4),
+                ("friction_angle", 30.0),
+                ("dilatancy_angle", psi),
+                ("hardening_modulus", 0.0),
+            ],
+        )
+        .unwrap()
+    };
+    let base = CompactionSpec {
+        element_size: 0.25,
+        load_steps: 10,
+        ..CompactionSpec::default()
+    };
+    for (what, spec, symmetric) in [
+        (
+            "Drucker–Prager associated",
+            CompactionSpec {
+                material: dp(30.0),
+                ..base
+            },
+            true,
+        ),
+        (
+            "Drucker–Prager ψ = 5°",
+            CompactionSpec {
+                material: dp(5.0),
+                ..base
+            },
+            false,
+        ),
+        ("Hencky with F-bar", CompactionSpec { f_bar: true, ..base }, false),
+    ] {
+        let start = std::time::Instant::now();
+        let (lu, lu_reports) = run_mpm(spec.mpm_solver().unwrap(), LinearSolver::Lu);
+        let lu_seconds = start.elapsed().as_secs_f64();
+        let start = std::time::Instant::now();
+        let (it, reports) = run_mpm(spec.mpm_solver().unwrap(), LinearSolver::Iterative);
+        let it_seconds = start.elapsed().as_secs_f64();
+        let d = relative_difference(&lu, &it);
+        let (stats, fallbacks) = it.linear_stats();
+        println!(
+            "{what}: {d:.1e} from LU, {} solves, {} by GMRES, {} Krylov iterations ({:.1} per solve), {fallbacks} fallbacks; {it_seconds:.2} s iterative, {lu_seconds:.2} s LU",
+            stats.solves,
+            stats.gmres_solves,
+            stats.iterations,
+            stats.iterations as f64 / stats.solves as f64
+        );
+        assert!(d < 1e-7, "{what}: {d:e}");
+        assert_eq!(fallbacks, 0, "{what}");
+        // A non-associated tangent is symmetric while no point is on the cone: those solves
+        // are CG's.
+        if symmetric {
+            assert_eq!(stats.gmres_solves, 0, "{what}: GMRES solves");
+        } else {
+            assert!(stats.gmres_solves > 0, "{what}: no GMRES solve");
+        }
+        let iterations = |r: &[StepReport]| r.iter().map(|s| s.newton.iterations()).collect::<Vec<_>>();
+        assert_eq!(
+            iterations(&reports),
+            iterations(&lu_reports),
+            "{what}: Newton iterations"
+        );
+    }
+}
