@@ -137,6 +137,9 @@ pub mod seeded {
         DruckerPragerSmoothApex = 10,
         /// F-bar's tangent without its F-bar terms: the plain tangent at F̄.
         FBarWithoutItsTangent = 11,
+        /// Mohr–Coulomb's edge states returned with one multiplier: the main plane's return
+        /// accepted even where it breaks the ordering τ₁ ≥ τ₂ ≥ τ₃.
+        MohrCoulombEdgeOneMultiplier = 12,
     }
 
     static ACTIVE: AtomicU8 = AtomicU8::new(0);

@@ -16,6 +16,7 @@
 //! | CPDI corners moved against the grid | the column study's CPDI rate bands |
 //! | TLMPM with ∇₀S as the start-of-step gradient (no Fₙ⁻ᵀ) | the column study's TLMPM rate bands |
 //! | dynamic tangent without its mass term M/(βΔt²) | Newton order on the vibrating bar (check_quadratic, order ≥ 1.8) |
+//! | Mohr–Coulomb's edge returned with one multiplier | \|f\| ≤ 1e-10 c₀ after returns from triaxial trial states |
 
 use igimp::basis::method::Method;
 use igimp::problems::manufactured::{errors, solve, Exact, Field, ManufacturedSpec, PointValue};
@@ -275,6 +276,31 @@ fn drucker_prager_apex_error() -> f64 {
     worst
 }
 
+/// The largest |f| / c₀ after Mohr–Coulomb's return from triaxial trial states (two equal
+/// principal strains: axial compression returns to the left edge τ₁ = τ₂, axial extension to
+/// the right edge τ₂ = τ₃), f on the ordered principal stresses: 0 to round-off when the edge
+/// is returned to with its two multipliers.
+fn mohr_coulomb_edge_error() -> f64 {
+    use igimp::material::constitutive::{ConstitutiveModel, MaterialState, MohrCoulomb};
+    use nalgebra::{Matrix3, Vector3};
+    let m = MohrCoulomb::try_new(1e5, 0.3, 50.0, 30.0, 30.0, 0.0).unwrap();
+    let mut worst: f64 = 0.0;
+    for k in 1..=10 {
+        let a = 2e-3 * k as f64;
+        for d in [
+            Vector3::new(-a, 0.5 * a, 0.5 * a),
+            Vector3::new(a, -0.5 * a, -0.5 * a),
+        ] {
+            let r = m
+                .update(&Matrix3::from_diagonal(&d), &MaterialState::default())
+                .unwrap();
+            assert!(r.internal.get(0) > 0.0, "the triaxial state {d} stayed elastic");
+            worst = worst.max(m.yield_function(&r.tau, r.internal.get(0)).abs() / 50.0);
+        }
+    }
+    worst
+}
+
 /// max |K − K_fd| / max |K| of iGIMP with F-bar on the yielding compaction block (von Mises,
 /// σ_y = 2.5e4, h = 1, at its last step), as `tests/verification/fbar.rs` checks it, with
 /// `bug` switched on for the check only (the steps before it are solved correctly).
@@ -453,6 +479,23 @@ fn every_seeded_bug_is_caught() {
     assert!(
         wrong > 1e-6,
         "F-bar's tangent without its terms passed: {wrong:e}"
+    );
+
+    // 13. Mohr–Coulomb's edges returned with one multiplier (the main plane's return kept
+    //     where it breaks the ordering): the returned stress leaves the yield surface
+    //     (tests/verification/mohr_coulomb.rs checks |f| ≤ 1e-10 c₀ and the ordering).
+    let right = mohr_coulomb_edge_error();
+    set(Bug::MohrCoulombEdgeOneMultiplier);
+    let wrong = mohr_coulomb_edge_error();
+    set(Bug::None);
+    eprintln!("Mohr–Coulomb edge with one multiplier: |f|/c₀ {wrong:.2e} (correct {right:.1e})");
+    assert!(
+        right <= 1e-10,
+        "the correct edge return leaves |f|/c₀ = {right:e}"
+    );
+    assert!(
+        wrong > 1e-3,
+        "an edge returned with one multiplier passed the yield-surface check: {wrong:e}"
     );
 
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.

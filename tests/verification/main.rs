@@ -29,6 +29,7 @@ mod fem3d;
 mod hostile;
 mod layering;
 mod manufactured;
+mod mohr_coulomb;
 mod multigrid;
 mod patch;
 mod plasticity;

@@ -16,12 +16,14 @@
 
 mod drucker_prager;
 mod linear_elastic;
+mod mohr_coulomb;
 mod neo_hookean;
 pub mod registry;
 mod von_mises;
 
 pub use drucker_prager::{DruckerPrager, ENTRY as DRUCKER_PRAGER, EQUIVALENT_PLASTIC_STRAIN};
 pub use linear_elastic::{lame, LinearElastic, ENTRY as LINEAR_ELASTIC};
+pub use mohr_coulomb::{MohrCoulomb, ReturnBranch, ENTRY as MOHR_COULOMB};
 pub use neo_hookean::{NeoHookean, ENTRY as NEO_HOOKEAN};
 pub use registry::{Material, ModelEntry, Parameter};
 pub use von_mises::{VonMises, ENTRY as VON_MISES, PLASTIC_MULTIPLIER};

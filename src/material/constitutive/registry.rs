@@ -54,12 +54,13 @@ pub struct ModelEntry {
 }
 
 /// The models igimp ships: Hencky elasticity, von Mises perfect plasticity, compressible
-/// neo-Hookean elasticity and Drucker–Prager plasticity.
-pub static BUILT_IN: [&ModelEntry; 4] = [
+/// neo-Hookean elasticity, Drucker–Prager and Mohr–Coulomb plasticity.
+pub static BUILT_IN: [&ModelEntry; 5] = [
     &super::LINEAR_ELASTIC,
     &super::VON_MISES,
     &super::NEO_HOOKEAN,
     &super::DRUCKER_PRAGER,
+    &super::MOHR_COULOMB,
 ];
 
 /// Models added by the program ([`register`]), after the built-in ones.
