@@ -137,6 +137,9 @@ pub mod seeded {
         DruckerPragerSmoothApex = 10,
         /// F-bar's tangent without its F-bar terms: the plain tangent at F̄.
         FBarWithoutItsTangent = 11,
+        /// Modified Cam-Clay's consistent tangent without the hardening of p_c: the terms of
+        /// ∂p_c/∂εᵥᵉ and ∂p_c/∂εᵥᵗ left out of the linearised return.
+        CamClayTangentWithoutHardening = 13,
     }
 
     static ACTIVE: AtomicU8 = AtomicU8::new(0);
