@@ -140,6 +140,9 @@ pub mod seeded {
         /// Mohr–Coulomb's edge states returned with one multiplier: the main plane's return
         /// accepted even where it breaks the ordering τ₁ ≥ τ₂ ≥ τ₃.
         MohrCoulombEdgeOneMultiplier = 12,
+        /// Modified Cam-Clay's consistent tangent without the hardening of p_c: the terms of
+        /// ∂p_c/∂εᵥᵉ and ∂p_c/∂εᵥᵗ left out of the linearised return.
+        CamClayTangentWithoutHardening = 13,
     }
 
     static ACTIVE: AtomicU8 = AtomicU8::new(0);

@@ -17,6 +17,7 @@
 //! | TLMPM with ∇₀S as the start-of-step gradient (no Fₙ⁻ᵀ) | the column study's TLMPM rate bands |
 //! | dynamic tangent without its mass term M/(βΔt²) | Newton order on the vibrating bar (check_quadratic, order ≥ 1.8) |
 //! | Mohr–Coulomb's edge returned with one multiplier | \|f\| ≤ 1e-10 c₀ after returns from triaxial trial states |
+//! | modified Cam-Clay's tangent without the hardening of p_c | central differences of the update (1e-6) on the wet side |
 
 use igimp::basis::method::Method;
 use igimp::problems::manufactured::{errors, solve, Exact, Field, ManufacturedSpec, PointValue};
@@ -276,6 +277,47 @@ fn drucker_prager_apex_error() -> f64 {
     worst
 }
 
+/// The largest |D_fd − D| / |D| of modified Cam-Clay's tangent (central differences, h = 1e-8,
+/// as tests/verification/cam_clay.rs checks it) at plastic states on the wet side from a
+/// hardened state, where p_c hardens.
+fn cam_clay_tangent_error() -> f64 {
+    use igimp::material::constitutive::{
+        ConstitutiveModel, InternalVariables, MaterialState, ModifiedCamClay,
+    };
+    use igimp::material::tensor::contract;
+    use nalgebra::Matrix3;
+    let m = ModifiedCamClay::try_new(3000.0, 0.02, 0.1, 1.2, 100.0, 100.0).unwrap();
+    let s = MaterialState {
+        internal: InternalVariables::from_slice(&[-0.02]),
+        ..Default::default()
+    };
+    let mut worst: f64 = 0.0;
+    for k in 1..=5 {
+        let mut eps = Matrix3::identity() * (-0.02 * k as f64);
+        eps[(0, 0)] -= 0.01;
+        eps[(0, 1)] = 0.004;
+        eps[(1, 0)] = 0.004;
+        assert!(
+            m.update(&eps, &s).unwrap().internal.get(0) < -0.02,
+            "elastic state {k}"
+        );
+        let d_alg = m.tangent(&eps, &s);
+        for i in 0..3 {
+            for j in 0..3 {
+                let mut d = Matrix3::zeros();
+                d[(i, j)] += 0.5;
+                d[(j, i)] += 0.5;
+                let h = 1e-8;
+                let fd = (m.update(&(eps + d * h), &s).unwrap().tau
+                    - m.update(&(eps - d * h), &s).unwrap().tau)
+                    / (2.0 * h);
+                worst = worst.max((fd - contract(&d_alg, &d)).amax() / d_alg.amax());
+            }
+        }
+    }
+    worst
+}
+
 /// The largest |f| / c₀ after Mohr–Coulomb's return from triaxial trial states (two equal
 /// principal strains: axial compression returns to the left edge τ₁ = τ₂, axial extension to
 /// the right edge τ₂ = τ₃), f on the ordered principal stresses: 0 to round-off when the edge
@@ -496,6 +538,19 @@ fn every_seeded_bug_is_caught() {
     assert!(
         wrong > 1e-3,
         "an edge returned with one multiplier passed the yield-surface check: {wrong:e}"
+    );
+
+    // 14. Modified Cam-Clay's tangent without the hardening of p_c: the finite-difference check
+    //     of tests/verification/cam_clay.rs (1e-6) fails on the wet side.
+    let right = cam_clay_tangent_error();
+    set(Bug::CamClayTangentWithoutHardening);
+    let wrong = cam_clay_tangent_error();
+    set(Bug::None);
+    eprintln!("Cam-Clay tangent without hardening: FD error {wrong:.2e} (correct {right:.1e})");
+    assert!(right < 1e-6, "the correct Cam-Clay tangent is off by {right:e}");
+    assert!(
+        wrong > 1e-6,
+        "Cam-Clay's tangent without hardening passed: {wrong:e}"
     );
 
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.

@@ -14,6 +14,8 @@ mod custom_basis;
 mod hardening_von_mises;
 
 mod basis;
+mod cam_clay;
+mod cam_clay_paths;
 mod column;
 mod compaction;
 mod drucker_prager;

@@ -377,18 +377,20 @@ fn gimp_3d_global_tangent_matches_central_differences_rotated_stretched_plastic_
 #[test]
 fn stress_update_is_objective_under_oblique_rotation_3d() {
     use igimp::material::constitutive::VonMises;
-    use igimp::material::constitutive::{DruckerPrager, MohrCoulomb, NeoHookean};
+    use igimp::material::constitutive::{DruckerPrager, ModifiedCamClay, MohrCoulomb, NeoHookean};
     use nalgebra::{Rotation3, Unit, Vector3};
     // Every built-in model: Hencky, von Mises, neo-Hookean, Drucker–Prager (associated
-    // and not, yielding on the cone and at the apex at these strains) and Mohr–Coulomb
-    // (non-associated, hardening).
-    let models: [Box<dyn ConstitutiveModel>; 6] = [
+    // and not, yielding on the cone and at the apex at these strains), Mohr–Coulomb
+    // (non-associated, hardening) and modified Cam-Clay (yielding from its initial isotropic
+    // stress −p₀ 1).
+    let models: [Box<dyn ConstitutiveModel>; 7] = [
         Box::new(LinearElastic::try_new(1e5, 0.25).unwrap()),
         Box::new(VonMises::try_new(1e5, 0.25, 3e3).unwrap()),
         Box::new(NeoHookean::try_new(1e5, 0.25).unwrap()),
         Box::new(DruckerPrager::try_new(1e5, 0.25, 2e3, 30.0, 30.0, 0.0).unwrap()),
         Box::new(DruckerPrager::try_new(1e5, 0.25, 2e3, 30.0, 10.0, 1e4).unwrap()),
         Box::new(MohrCoulomb::try_new(1e5, 0.25, 2e3, 30.0, 10.0, 1e4).unwrap()),
+        Box::new(ModifiedCamClay::try_new(3e3, 0.05, 0.2, 1.2, 100.0, 150.0).unwrap()),
     ];
     assert_eq!(
         models.len(),

@@ -14,6 +14,7 @@
 //! [`registry::BUILT_IN`], or, outside the crate, one [`registry::register`] call
 //! (`examples/hardening_von_mises.rs`).
 
+mod cam_clay;
 mod drucker_prager;
 mod linear_elastic;
 mod mohr_coulomb;
@@ -21,6 +22,7 @@ mod neo_hookean;
 pub mod registry;
 mod von_mises;
 
+pub use cam_clay::{ModifiedCamClay, ENTRY as MODIFIED_CAM_CLAY, PLASTIC_VOLUMETRIC_STRAIN};
 pub use drucker_prager::{DruckerPrager, ENTRY as DRUCKER_PRAGER, EQUIVALENT_PLASTIC_STRAIN};
 pub use linear_elastic::{lame, LinearElastic, ENTRY as LINEAR_ELASTIC};
 pub use mohr_coulomb::{MohrCoulomb, ReturnBranch, ENTRY as MOHR_COULOMB};

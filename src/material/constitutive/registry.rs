@@ -26,14 +26,15 @@ pub struct Parameter {
     pub meaning: &'static str,
 }
 
-/// Young's modulus, the first parameter of every built-in model.
+/// Young's modulus, the first parameter of every built-in model but modified Cam-Clay (whose
+/// bulk stiffness is pressure dependent).
 pub const YOUNG_MODULUS: Parameter = Parameter {
     name: "young_modulus",
     unit: "Pa",
     meaning: "Young's modulus E, > 0",
 };
 
-/// Poisson's ratio, the second parameter of every built-in model.
+/// Poisson's ratio, the second parameter of every built-in model but modified Cam-Clay.
 pub const POISSON_RATIO: Parameter = Parameter {
     name: "poisson_ratio",
     unit: "1",
@@ -54,13 +55,14 @@ pub struct ModelEntry {
 }
 
 /// The models igimp ships: Hencky elasticity, von Mises perfect plasticity, compressible
-/// neo-Hookean elasticity, Drucker–Prager and Mohr–Coulomb plasticity.
-pub static BUILT_IN: [&ModelEntry; 5] = [
+/// neo-Hookean elasticity, Drucker–Prager and Mohr–Coulomb plasticity and modified Cam-Clay.
+pub static BUILT_IN: [&ModelEntry; 6] = [
     &super::LINEAR_ELASTIC,
     &super::VON_MISES,
     &super::NEO_HOOKEAN,
     &super::DRUCKER_PRAGER,
     &super::MOHR_COULOMB,
+    &super::MODIFIED_CAM_CLAY,
 ];
 
 /// Models added by the program ([`register`]), after the built-in ones.
