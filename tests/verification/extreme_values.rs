@@ -14,6 +14,7 @@ use igimp::study::cantilever::CantileverStudy;
 use igimp::study::column::ColumnStudy;
 use igimp::study::compaction::CompactionStudy;
 use igimp::study::dynamics::DynamicStudy;
+use igimp::study::element::ElementStudy;
 use igimp::study::engine::{self, StudyKind};
 use igimp::study::manufactured::ManufacturedStudy;
 use igimp::study::results::CaseRecordOf;
@@ -266,6 +267,7 @@ fn probe_kind(problem: &str) {
             "manufactured" => probe::<ManufacturedStudy>(&name, &text, &mut tally),
             "dynamics" => probe::<DynamicStudy>(&name, &text, &mut tally),
             "scene" => probe::<SceneStudy>(&name, &text, &mut tally),
+            "element" => probe::<ElementStudy>(&name, &text, &mut tally),
             other => panic!("{name}: no probe for problem {other:?}"),
         }
         assert!(tally.rejected > 0 && tally.accepted > 0, "{name}: nothing probed");
@@ -314,6 +316,11 @@ fn extreme_values_in_dynamics_studies_are_rejected_or_solved_and_measured() {
 #[test]
 fn extreme_values_in_scene_studies_are_rejected_or_solved_and_measured() {
     probe_kind("scene");
+}
+
+#[test]
+fn extreme_values_in_element_studies_are_rejected_or_solved_and_measured() {
+    probe_kind("element");
 }
 
 /// Every `[material]` and `[materials.<name>]` table of every committed study file: an
@@ -389,7 +396,8 @@ fn every_study_kind_has_a_probe() {
                     "cantilever",
                     "manufactured",
                     "dynamics",
-                    "scene"
+                    "scene",
+                    "element"
                 ]
                 .contains(&problem),
                 "{}: no probe for problem {problem:?}",
