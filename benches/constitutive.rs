@@ -62,12 +62,14 @@ fn block(material: Material) -> scene::Scene {
         grid: scene::GridSection,
         bodies: Vec<scene::Body>,
         supports: Vec<scene::Support>,
+        loads: Vec<scene::Load>,
     }
     let p: Parts = toml::from_str(
         r#"
 grid = { origin = [0.0, 0.0], extent = [5.0, 4.0] }
 bodies = [{ name = "soil", box = { min = [0.0, 0.0], max = [5.0, 3.0] }, material = "m" }]
 supports = [{ name = "base", plane = { axis = "y", at = 0.0 }, fix = ["x", "y"] }]
+loads = [{ kind = "gravity", vector = [0.0, -1.0] }]
 "#,
     )
     .unwrap();
@@ -77,7 +79,7 @@ supports = [{ name = "base", plane = { axis = "y", at = 0.0 }, fix = ["x", "y"] 
         materials: [("m".to_string(), material)].into_iter().collect(),
         bodies: p.bodies,
         supports: p.supports,
-        loads: vec![],
+        loads: p.loads,
         measures: vec![],
     }
 }
