@@ -237,3 +237,75 @@ loads = [{ kind = "displacement", name = "footing", box = { min = [0.0, 1.5], ma
     s.validate().unwrap();
     s
 }
+
+/// The pressure-dependent models under F-bar: the compaction block (h = 1, iGIMP and TLMPM,
+/// and Q4) at 1 % of its load and a random increment, in Drucker–Prager and Mohr–Coulomb
+/// (φ = 30°, associated and ψ = 5°, c = 50, so that the increment yields points) and modified
+/// Cam-Clay (normally consolidated: compressed points yield; its initial stress −p₀ 1 out
+/// of balance, which a tangent check does not need), within 1e-6, with points yielding.
+#[test]
+fn fbar_tangent_matches_central_differences_for_the_geomaterials() {
+    use igimp::fem::QuadElement;
+    let friction = |model: &str, psi: f64| {
+        Material::new(
+            model,
+            &[
+                ("young_modulus", 1e5),
+                ("poisson_ratio", 0.3),
+                ("cohesion", 50.0),
+                ("friction_angle", 30.0),
+                ("dilatancy_angle", psi),
+                ("hardening_modulus", 0.0),
+            ],
+        )
+        .unwrap()
+    };
+    let cam_clay = Material::new(
+        "modified-cam-clay",
+        &[
+            ("shear_modulus", 3e4),
+            ("swelling_index", 0.02),
+            ("compression_index", 0.1),
+            ("critical_state_slope", 1.2),
+            ("reference_pressure", 1e4),
+            ("preconsolidation_pressure", 1e4),
+        ],
+    )
+    .unwrap();
+    // The FD error, and the points whose update moved their plastic variable (all start at 0
+    // in the first step) at the last increment the check evaluated.
+    fn checked<const D: usize>(sys: &mut igimp::discretise::assembly::LoadStepSystem<'_, D>) -> (f64, usize) {
+        let (err, _, _) = crate::common::fd_tangent_errors(sys, 2e-3, 11);
+        let plastic = sys
+            .trials
+            .iter()
+            .filter(|t| t.as_ref().is_some_and(|t| t.response.internal.get(0) != 0.0))
+            .count();
+        (err, plastic)
+    }
+    for (name, material) in [
+        ("Drucker–Prager", friction("drucker-prager", 30.0)),
+        ("Drucker–Prager ψ = 5°", friction("drucker-prager", 5.0)),
+        ("Mohr–Coulomb", friction("mohr-coulomb", 30.0)),
+        ("Mohr–Coulomb ψ = 5°", friction("mohr-coulomb", 5.0)),
+        ("Cam-Clay", cam_clay),
+    ] {
+        for basis in [Basis::Gimp, Basis::Tlmpm] {
+            let spec = CompactionSpec {
+                basis,
+                ..block(material, 2)
+            };
+            let mut solver = spec.mpm_solver().unwrap();
+            let (err, plastic) = solver.with_step_system(0.01, checked).unwrap();
+            eprintln!("{basis:?} {name}: {err:.2e} ({plastic} points yielding)");
+            assert!(err < 1e-6, "{basis:?} {name}: tangent error {err:e}");
+            assert!(plastic > 0, "{basis:?} {name}: no point yields");
+        }
+        let (mut fem, _) =
+            igimp::problems::compaction::fem_solver(&block(material, 2), QuadElement::Q4).unwrap();
+        let (err, plastic) = fem.with_step_system(0.01, checked).unwrap();
+        eprintln!("Q4 {name}: {err:.2e} ({plastic} Gauss points yielding)");
+        assert!(err < 1e-6, "Q4 {name}: tangent error {err:e}");
+        assert!(plastic > 0, "Q4 {name}: no point yields");
+    }
+}
