@@ -1,5 +1,5 @@
+use super::friction::{self, EQUIVALENT_PLASTIC_STRAIN};
 use super::linear_elastic::lame;
-use super::registry::{Parameter, POISSON_RATIO, YOUNG_MODULUS};
 use super::{
     ConstitutiveModel, InternalVariable, InternalVariables, MaterialError, MaterialResponse, MaterialState,
     ModelEntry,
@@ -13,54 +13,18 @@ use nalgebra::Matrix3;
 pub static ENTRY: ModelEntry = ModelEntry {
     name: "drucker-prager",
     summary: "Drucker–Prager plasticity on the Kirchhoff stress, Hencky elasticity, plane-strain match to Mohr–Coulomb, apex return, linear cohesion hardening",
-    parameters: &[
-        YOUNG_MODULUS,
-        POISSON_RATIO,
-        Parameter {
-            name: "cohesion",
-            unit: "Pa",
-            meaning: "Mohr–Coulomb cohesion c₀, ≥ 0",
-        },
-        Parameter {
-            name: "friction_angle",
-            unit: "°",
-            meaning: "Mohr–Coulomb friction angle φ, in [0, 90)",
-        },
-        Parameter {
-            name: "dilatancy_angle",
-            unit: "°",
-            meaning: "dilatancy angle ψ, in [0, φ] (ψ = φ: associated flow)",
-        },
-        Parameter {
-            name: "hardening_modulus",
-            unit: "Pa",
-            meaning: "H of the cohesion c = c₀ + H ε̄ᵖ (< 0 softens)",
-        },
-    ],
+    parameters: &friction::PARAMETERS,
     build: |m| {
-        Ok(Box::new(DruckerPrager::try_new(
-            m.value("young_modulus"),
-            m.value("poisson_ratio"),
-            m.value("cohesion"),
-            m.value("friction_angle"),
-            m.value("dilatancy_angle"),
-            m.value("hardening_modulus"),
-        )?))
+        let [e, nu, c, phi, psi, h] = friction::values(m);
+        Ok(Box::new(DruckerPrager::try_new(e, nu, c, phi, psi, h)?))
     },
-};
-
-/// Drucker–Prager's internal variable: the accumulated plastic strain ε̄ᵖ that hardens the
-/// cohesion (ξ Δγ per step on the cone, (ξ/η̄) Δεᵥᵖ at the apex).
-pub const EQUIVALENT_PLASTIC_STRAIN: InternalVariable = InternalVariable {
-    name: "equivalent_plastic_strain",
-    initial: 0.0,
-    meaning: "accumulated plastic strain ε̄ᵖ of the cohesion's hardening, 0 where the point never yielded",
 };
 
 /// Drucker–Prager plasticity in Kirchhoff stress / logarithmic strain space (de Souza Neto,
 /// Perić & Owen 2008, §8.3.4 and Box 8.9, applied to the trial log strain as von Mises is,
 /// reference/README.md item 68): f = √J₂(s) + η p − ξ c(ε̄ᵖ), p = tr τ / 3 (tension positive),
-/// flow potential √J₂ + η̄ p, cohesion c = c₀ + H ε̄ᵖ. The cone is the plane-strain match to
+/// flow potential √J₂ + η̄ p, cohesion c = c₀ + H ε̄ᵖ (ε̄ᵖ += ξ Δγ on the cone, (ξ/η̄) Δεᵥᵖ at the
+/// apex). The cone is the plane-strain match to
 /// Mohr–Coulomb: η = 3 tan φ / √(9 + 12 tan²φ), ξ = 3 / √(9 + 12 tan²φ), η̄ from ψ as η from
 /// φ; it gives Mohr–Coulomb's collapse load in plane strain under associated flow.
 ///
@@ -117,34 +81,7 @@ impl DruckerPrager {
         hardening_modulus: f64,
     ) -> Result<Self, InputError> {
         let elastic = super::LinearElastic::try_new(young_modulus, poisson_ratio)?;
-        if !(cohesion.is_finite() && cohesion >= 0.0) {
-            return Err(InputError::new(
-                "material.cohesion",
-                cohesion,
-                "must be finite and ≥ 0",
-            ));
-        }
-        if !(friction_angle.is_finite() && (0.0..90.0).contains(&friction_angle)) {
-            return Err(InputError::new(
-                "material.friction_angle",
-                friction_angle,
-                "must lie in [0, 90) degrees",
-            ));
-        }
-        if !(dilatancy_angle.is_finite() && (0.0..=friction_angle).contains(&dilatancy_angle)) {
-            return Err(InputError::new(
-                "material.dilatancy_angle",
-                dilatancy_angle,
-                format!("must lie in [0, friction_angle = {friction_angle}] degrees"),
-            ));
-        }
-        if !hardening_modulus.is_finite() {
-            return Err(InputError::new(
-                "material.hardening_modulus",
-                hardening_modulus,
-                "must be finite",
-            ));
-        }
+        friction::check(cohesion, friction_angle, dilatancy_angle, hardening_modulus)?;
         let (lambda, mu) = lame(young_modulus, poisson_ratio);
         let (eta, xi) = plane_strain_match(friction_angle);
         let (eta_bar, _) = plane_strain_match(dilatancy_angle);

@@ -16,6 +16,7 @@
 
 mod cam_clay;
 mod drucker_prager;
+mod friction;
 mod linear_elastic;
 mod mohr_coulomb;
 mod neo_hookean;
@@ -23,7 +24,8 @@ pub mod registry;
 mod von_mises;
 
 pub use cam_clay::{ModifiedCamClay, ENTRY as MODIFIED_CAM_CLAY, PLASTIC_VOLUMETRIC_STRAIN};
-pub use drucker_prager::{DruckerPrager, ENTRY as DRUCKER_PRAGER, EQUIVALENT_PLASTIC_STRAIN};
+pub use drucker_prager::{DruckerPrager, ENTRY as DRUCKER_PRAGER};
+pub use friction::EQUIVALENT_PLASTIC_STRAIN;
 pub use linear_elastic::{lame, LinearElastic, ENTRY as LINEAR_ELASTIC};
 pub use mohr_coulomb::{MohrCoulomb, ReturnBranch, ENTRY as MOHR_COULOMB};
 pub use neo_hookean::{NeoHookean, ENTRY as NEO_HOOKEAN};

@@ -1,5 +1,5 @@
+use super::friction::{self, EQUIVALENT_PLASTIC_STRAIN};
 use super::linear_elastic::lame;
-use super::registry::{Parameter, POISSON_RATIO, YOUNG_MODULUS};
 use super::{
     ConstitutiveModel, InternalVariable, InternalVariables, MaterialError, MaterialResponse, MaterialState,
     ModelEntry,
@@ -14,55 +14,19 @@ use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 pub static ENTRY: ModelEntry = ModelEntry {
     name: "mohr-coulomb",
     summary: "Mohr–Coulomb plasticity on the principal Kirchhoff stresses, Hencky elasticity, main-plane, edge and apex returns, linear cohesion hardening",
-    parameters: &[
-        YOUNG_MODULUS,
-        POISSON_RATIO,
-        Parameter {
-            name: "cohesion",
-            unit: "Pa",
-            meaning: "cohesion c₀, ≥ 0",
-        },
-        Parameter {
-            name: "friction_angle",
-            unit: "°",
-            meaning: "friction angle φ, in [0, 90)",
-        },
-        Parameter {
-            name: "dilatancy_angle",
-            unit: "°",
-            meaning: "dilatancy angle ψ, in [0, φ] (ψ = φ: associated flow)",
-        },
-        Parameter {
-            name: "hardening_modulus",
-            unit: "Pa",
-            meaning: "H of the cohesion c = c₀ + H ε̄ᵖ (< 0 softens)",
-        },
-    ],
+    parameters: &friction::PARAMETERS,
     build: |m| {
-        Ok(Box::new(MohrCoulomb::try_new(
-            m.value("young_modulus"),
-            m.value("poisson_ratio"),
-            m.value("cohesion"),
-            m.value("friction_angle"),
-            m.value("dilatancy_angle"),
-            m.value("hardening_modulus"),
-        )?))
+        let [e, nu, c, phi, psi, h] = friction::values(m);
+        Ok(Box::new(MohrCoulomb::try_new(e, nu, c, phi, psi, h)?))
     },
-};
-
-/// Mohr–Coulomb's internal variable, with de Souza Neto's rates (§8.2.2): 2 cos φ Δγ on the
-/// main plane, 2 cos φ (Δγ_a + Δγ_b) on an edge, (cos φ / sin ψ) Δεᵥᵖ at the apex.
-pub const EQUIVALENT_PLASTIC_STRAIN: InternalVariable = InternalVariable {
-    name: "equivalent_plastic_strain",
-    initial: 0.0,
-    meaning: "accumulated plastic strain ε̄ᵖ of the cohesion's hardening, 0 where the point never yielded",
 };
 
 /// Mohr–Coulomb plasticity in Kirchhoff stress / logarithmic strain space (de Souza Neto,
 /// Perić & Owen 2008, §8.2, Boxes 8.4–8.5, applied to the trial log strain as von Mises and
 /// Drucker–Prager are): on the principal stresses τ₁ ≥ τ₂ ≥ τ₃ (tension positive),
 /// f = (τ₁ − τ₃) + (τ₁ + τ₃) sin φ − 2 c cos φ, flow potential with ψ in place of φ,
-/// c = c₀ + H ε̄ᵖ. Hencky elasticity is isotropic, so the return acts on the principal values
+/// c = c₀ + H ε̄ᵖ, ε̄ᵖ growing at de Souza Neto's rates (§8.2.2): 2 cos φ Δγ on the main plane,
+/// 2 cos φ (Δγ_a + Δγ_b) on an edge, (cos φ / sin ψ) Δεᵥᵖ at the apex. Hencky elasticity is isotropic, so the return acts on the principal values
 /// of the trial strain and the stress keeps the trial eigenvectors.
 ///
 /// Return: the one-vector return to the main plane; where it breaks the ordering, the
@@ -159,34 +123,7 @@ impl MohrCoulomb {
         hardening_modulus: f64,
     ) -> Result<Self, InputError> {
         super::LinearElastic::try_new(young_modulus, poisson_ratio)?;
-        if !(cohesion.is_finite() && cohesion >= 0.0) {
-            return Err(InputError::new(
-                "material.cohesion",
-                cohesion,
-                "must be finite and ≥ 0",
-            ));
-        }
-        if !(friction_angle.is_finite() && (0.0..90.0).contains(&friction_angle)) {
-            return Err(InputError::new(
-                "material.friction_angle",
-                friction_angle,
-                "must lie in [0, 90) degrees",
-            ));
-        }
-        if !(dilatancy_angle.is_finite() && (0.0..=friction_angle).contains(&dilatancy_angle)) {
-            return Err(InputError::new(
-                "material.dilatancy_angle",
-                dilatancy_angle,
-                format!("must lie in [0, friction_angle = {friction_angle}] degrees"),
-            ));
-        }
-        if !hardening_modulus.is_finite() {
-            return Err(InputError::new(
-                "material.hardening_modulus",
-                hardening_modulus,
-                "must be finite",
-            ));
-        }
+        friction::check(cohesion, friction_angle, dilatancy_angle, hardening_modulus)?;
         let (lambda, mu) = lame(young_modulus, poisson_ratio);
         let (sin_phi, cos_phi) = friction_angle.to_radians().sin_cos();
         Ok(Self {
