@@ -19,6 +19,11 @@
 //! | Mohr–Coulomb's edge returned with one multiplier | \|f\| ≤ 1e-10 c₀ after returns from triaxial trial states |
 //! | modified Cam-Clay's tangent without the hardening of p_c | central differences of the update (1e-6) on the wet side |
 
+/// The integration tests' shared checks (the finite-difference tangents), so that a seeded bug
+/// meets the very check it is seeded against.
+#[path = "verification/common.rs"]
+mod common;
+
 use igimp::basis::method::Method;
 use igimp::problems::manufactured::{errors, solve, Exact, Field, ManufacturedSpec, PointValue};
 use igimp::seeded::{set, Bug};
@@ -284,7 +289,6 @@ fn cam_clay_tangent_error() -> f64 {
     use igimp::material::constitutive::{
         ConstitutiveModel, InternalVariables, MaterialState, ModifiedCamClay,
     };
-    use igimp::material::tensor::contract;
     use nalgebra::Matrix3;
     let m = ModifiedCamClay::try_new(3000.0, 0.02, 0.1, 1.2, 100.0, 100.0).unwrap();
     let s = MaterialState {
@@ -301,19 +305,7 @@ fn cam_clay_tangent_error() -> f64 {
             m.update(&eps, &s).unwrap().internal.get(0) < -0.02,
             "elastic state {k}"
         );
-        let d_alg = m.tangent(&eps, &s);
-        for i in 0..3 {
-            for j in 0..3 {
-                let mut d = Matrix3::zeros();
-                d[(i, j)] += 0.5;
-                d[(j, i)] += 0.5;
-                let h = 1e-8;
-                let fd = (m.update(&(eps + d * h), &s).unwrap().tau
-                    - m.update(&(eps - d * h), &s).unwrap().tau)
-                    / (2.0 * h);
-                worst = worst.max((fd - contract(&d_alg, &d)).amax() / d_alg.amax());
-            }
-        }
+        worst = worst.max(common::material_tangent_error(&m, &eps, &s, 0.0));
     }
     worst
 }
@@ -344,13 +336,12 @@ fn mohr_coulomb_edge_error() -> f64 {
 }
 
 /// max |K − K_fd| / max |K| of iGIMP with F-bar on the yielding compaction block (von Mises,
-/// σ_y = 2.5e4, h = 1, at its last step), as `tests/verification/fbar.rs` checks it, with
+/// σ_y = 2.5e4, h = 1, at its last step), by `tests/verification/fbar.rs`'s check and increment, with
 /// `bug` switched on for the check only (the steps before it are solved correctly).
 fn fbar_tangent_error(bug: Bug) -> f64 {
     use igimp::material::constitutive::Material;
     use igimp::problems::compaction::CompactionSpec;
     use igimp::solver::load_stepping::LoadStepping;
-    use igimp::solver::newton::NonlinearSystem;
     let spec = CompactionSpec {
         material: Material::von_mises(1e5, 0.3, 2.5e4),
         load_steps: 10,
@@ -363,30 +354,7 @@ fn fbar_tangent_error(bug: Bug) -> f64 {
     }
     set(bug);
     let err = solver
-        .with_step_system(1.0, |sys| {
-            let n = sys.num_unknowns();
-            let u0: Vec<f64> = (0..n).map(|i| 2e-3 * ((i as f64 * 0.7).sin())).collect();
-            let mut r = vec![0.0; n];
-            sys.evaluate(&u0, &mut r).unwrap();
-            sys.assemble_tangent();
-            let k: Vec<Vec<f64>> = (0..n)
-                .map(|i| (0..n).map(|j| sys.matrix.get(i, j)).collect())
-                .collect();
-            let (h, mut err, mut kmax) = (1e-7, 0.0f64, 0.0f64);
-            let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
-            for j in 0..n {
-                let mut u = u0.clone();
-                u[j] += h;
-                sys.evaluate(&u, &mut rp).unwrap();
-                u[j] -= 2.0 * h;
-                sys.evaluate(&u, &mut rm).unwrap();
-                for i in 0..n {
-                    err = err.max(((rp[i] - rm[i]) / (2.0 * h) - k[i][j]).abs());
-                    kmax = kmax.max(k[i][j].abs());
-                }
-            }
-            err / kmax
-        })
+        .with_step_system(1.0, |sys| common::fd_tangent_errors(sys, 2e-3, 5).0)
         .unwrap();
     set(Bug::None);
     err

@@ -9,7 +9,6 @@ use crate::common;
 use common::Rng;
 use igimp::material::constitutive::{ConstitutiveModel, MaterialState, ModifiedCamClay};
 use igimp::material::constitutive::{InternalVariables, Material};
-use igimp::material::tensor::contract;
 use nalgebra::Matrix3;
 
 pub const MU: f64 = 3000.0;
@@ -57,24 +56,6 @@ fn branch(m: &ModifiedCamClay, eps: &Matrix3<f64>, s: &MaterialState) -> Option<
     })
 }
 
-/// The largest |D_fd − D| of the update's central differences at `eps` (h = 1e-8), over |D|.
-pub fn tangent_error(m: &dyn ConstitutiveModel, eps: &Matrix3<f64>, s: &MaterialState) -> f64 {
-    let d_alg = m.tangent(eps, s);
-    let h = 1e-8;
-    let mut worst: f64 = 0.0;
-    for k in 0..3 {
-        for l in 0..3 {
-            let mut d = Matrix3::zeros();
-            d[(k, l)] += 0.5;
-            d[(l, k)] += 0.5;
-            let fd = (m.update(&(eps + d * h), s).unwrap().tau - m.update(&(eps - d * h), s).unwrap().tau)
-                / (2.0 * h);
-            worst = worst.max((fd - contract(&d_alg, &d)).amax() / d_alg.amax());
-        }
-    }
-    worst
-}
-
 /// Random trial strains away from the elastic–plastic kink (the branch the same at 0.99 and
 /// 1.01 times the strain): D^alg matches central differences to 1e-6 on each of the four
 /// branches, seen at least 5 times each, for a normally consolidated and an overconsolidated
@@ -102,7 +83,7 @@ fn cam_clay_tangent_matches_central_differences_on_every_branch() {
                 if near {
                     continue;
                 }
-                let e = tangent_error(&m, &eps, &s);
+                let e = common::material_tangent_error(&m, &eps, &s, 0.0);
                 assert!(
                     e <= 1e-6,
                     "p_c0 = {pc0}, εᵥᵖ = {evp}, {}: tangent off by {e:e}",

@@ -118,3 +118,29 @@ pub fn fd_tangent_errors<const D: usize>(
     }
     (err / kmax, asym / kmax, rho)
 }
+
+/// The largest |D_fd − D| of `m`'s update by central differences at `eps` (h = 1e-8,
+/// symmetric perturbations), over max(|D|, `floor`): a floor such as E where D vanishes (the
+/// apex of perfect plasticity, where the stress is fixed), 0 otherwise.
+pub fn material_tangent_error(
+    m: &dyn ConstitutiveModel,
+    eps: &Matrix3<f64>,
+    s: &igimp::material::constitutive::MaterialState,
+    floor: f64,
+) -> f64 {
+    let d_alg = m.tangent(eps, s);
+    let h = 1e-8;
+    let mut worst: f64 = 0.0;
+    for k in 0..3 {
+        for l in 0..3 {
+            let mut d = Matrix3::zeros();
+            d[(k, l)] += 0.5;
+            d[(l, k)] += 0.5;
+            let fd = (m.update(&(eps + d * h), s).unwrap().tau - m.update(&(eps - d * h), s).unwrap().tau)
+                / (2.0 * h);
+            let exact = igimp::material::tensor::contract(&d_alg, &d);
+            worst = worst.max((fd - exact).amax() / d_alg.amax().max(floor));
+        }
+    }
+    worst
+}

@@ -8,7 +8,6 @@ use crate::common;
 use common::Rng;
 use igimp::material::constitutive::{ConstitutiveModel, DruckerPrager, MaterialState};
 use igimp::material::constitutive::{InternalVariables, Material};
-use igimp::material::tensor::contract;
 use nalgebra::Matrix3;
 
 const E: f64 = 1e5;
@@ -42,25 +41,6 @@ fn branch(m: &DruckerPrager, eps: &Matrix3<f64>, s: &MaterialState) -> usize {
     }
 }
 
-/// The largest |D_fd − D| of the update's central differences at `eps` (h = 1e-8), over |D|
-/// (over E where D vanishes: the apex of perfect plasticity, where the stress is fixed).
-fn tangent_error(m: &DruckerPrager, eps: &Matrix3<f64>, s: &MaterialState) -> f64 {
-    let d_alg = m.tangent(eps, s);
-    let h = 1e-8;
-    let mut worst: f64 = 0.0;
-    for k in 0..3 {
-        for l in 0..3 {
-            let mut d = Matrix3::zeros();
-            d[(k, l)] += 0.5;
-            d[(l, k)] += 0.5;
-            let fd = (m.update(&(eps + d * h), s).unwrap().tau - m.update(&(eps - d * h), s).unwrap().tau)
-                / (2.0 * h);
-            worst = worst.max((fd - contract(&d_alg, &d)).amax() / d_alg.amax().max(E));
-        }
-    }
-    worst
-}
-
 /// Random trial strains, each on a branch away from its edges (f_t, the cone's q and the apex
 /// margin not within 1 % of a kink): D^alg matches central differences to 1e-6 on every
 /// branch, for associated and non-associated flow, perfect plasticity, hardening and
@@ -88,7 +68,7 @@ fn drucker_prager_tangent_matches_central_differences_on_every_branch() {
                 if near {
                     continue;
                 }
-                let e = tangent_error(m, &eps, &s);
+                let e = common::material_tangent_error(m, &eps, &s, E);
                 assert!(
                     e <= 1e-6,
                     "model {i}, ε̄ᵖ = {ep}, branch {b}: tangent off by {e:e}"

@@ -11,7 +11,7 @@ use common::Rng;
 use igimp::material::constitutive::{ConstitutiveModel, InternalVariables, Material, MaterialState};
 use igimp::material::constitutive::{MohrCoulomb, ReturnBranch};
 use igimp::material::kinematics::sym_eigen;
-use igimp::material::tensor::{contract, ij};
+use igimp::material::tensor::ij;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 const E: f64 = 1e5;
@@ -83,25 +83,6 @@ fn index(b: ReturnBranch) -> usize {
 
 const NAMES: [&str; 5] = ["elastic", "main plane", "left edge", "right edge", "apex"];
 
-/// The largest |D_fd − D| of the update's central differences at `eps` (h = 1e-8, symmetric
-/// perturbations), over |D| (over E where D vanishes: a perfectly plastic apex).
-fn tangent_error(m: &MohrCoulomb, eps: &Matrix3<f64>, s: &MaterialState) -> f64 {
-    let d_alg = m.tangent(eps, s);
-    let h = 1e-8;
-    let mut worst: f64 = 0.0;
-    for k in 0..3 {
-        for l in 0..3 {
-            let mut d = Matrix3::zeros();
-            d[(k, l)] += 0.5;
-            d[(l, k)] += 0.5;
-            let fd = (m.update(&(eps + d * h), s).unwrap().tau - m.update(&(eps - d * h), s).unwrap().tau)
-                / (2.0 * h);
-            worst = worst.max((fd - contract(&d_alg, &d)).amax() / d_alg.amax().max(E));
-        }
-    }
-    worst
-}
-
 /// Whether every state within 1 % of `eps` (scaled by 0.99 and 1.01, and moved by three random
 /// perturbations of 1 % of its size) returns to the same branch: away from a kink.
 fn away_from_kinks(m: &MohrCoulomb, eps: &Matrix3<f64>, s: &MaterialState, rng: &mut Rng) -> bool {
@@ -144,7 +125,7 @@ fn mohr_coulomb_tangent_matches_central_differences_on_every_branch() {
                     continue;
                 }
                 let b = index(m.branch(&eps, &s).unwrap());
-                let e = tangent_error(m, &eps, &s);
+                let e = common::material_tangent_error(m, &eps, &s, E);
                 assert!(
                     e <= 1e-6,
                     "model {i}, ε̄ᵖ = {ep}, {}: tangent off by {e:e} at {eps}",
