@@ -173,9 +173,6 @@ pub fn measures(states: &[ElementState]) -> Vec<(&'static str, f64)> {
     out
 }
 
-/// The measures every test records after each step, for the figures.
-pub const HISTORIES: [&str; 4] = ["p", "q", "strain", "volumetric_strain"];
-
 #[cfg(test)]
 mod tests {
     use super::*;

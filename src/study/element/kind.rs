@@ -3,7 +3,7 @@
 //! closed form's value and the checks.
 
 use super::{ClosedFormRecord, ElementMeasures, ElementRecord, ElementResults, ElementStudy, TestSection};
-use crate::problems::element_test::closed_form::{measures, HISTORIES};
+use crate::problems::element_test::closed_form::measures;
 use crate::problems::element_test::{run, ElementState};
 use crate::study::checks::{check_at_most, CheckRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
@@ -80,17 +80,17 @@ fn solve_test(study: &ElementStudy, t: &TestSection) -> ElementRecord {
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
         .collect();
-    for name in HISTORIES {
-        let values = path
-            .iter()
-            .map(|s| {
-                measures(std::slice::from_ref(*s))
-                    .into_iter()
-                    .find(|(k, _)| *k == name)
-                    .map_or(f64::NAN, |(_, v)| v)
-            })
-            .collect();
-        rec.histories.insert(name.to_string(), values);
+    // The figures' curves, after each step of the path.
+    type Of = fn(&ElementState) -> f64;
+    let series: [(&str, Of); 4] = [
+        ("p", ElementState::p),
+        ("q", ElementState::q),
+        ("strain", |s| s.strain),
+        ("volumetric_strain", ElementState::volumetric_strain),
+    ];
+    for (name, of) in series {
+        rec.histories
+            .insert(name.to_string(), path.iter().map(|s| of(s)).collect());
     }
     rec
 }
