@@ -94,6 +94,7 @@ fn residual_2d(c: &mut Criterion) {
         domain_update: Default::default(),
         linear_solver: Default::default(),
         f_bar: false,
+        pressure_projection: false,
         gauss_points: None,
     };
     for (name, material) in materials() {

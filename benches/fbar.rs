@@ -78,6 +78,7 @@ fn footing_2d(c: &mut Criterion) {
                 domain_update: Default::default(),
                 linear_solver: Default::default(),
                 f_bar,
+                pressure_projection: false,
                 gauss_points: None,
             };
             let discrete = DiscreteScene::of(&scene, &settings).unwrap();

@@ -95,6 +95,7 @@ fn main() {
                     domain_update: spec.domain_update,
                     linear_solver: spec.linear_solver,
                     f_bar: false,
+                    pressure_projection: false,
                     gauss_points: None,
                 };
                 let (o, cost) = pool.run(|| {

@@ -143,6 +143,9 @@ pub mod seeded {
         /// Modified Cam-Clay's consistent tangent without the hardening of p_c: the terms of
         /// ∂p_c/∂εᵥᵉ and ∂p_c/∂εᵥᵗ left out of the linearised return.
         CamClayTangentWithoutHardening = 13,
+        /// The pressure projection's tangent without its patch block R Pᵀ: the rate of the
+        /// cell's mean pressure left out.
+        PressureProjectionWithoutItsBlock = 14,
     }
 
     static ACTIVE: AtomicU8 = AtomicU8::new(0);

@@ -339,6 +339,12 @@ fn mohr_coulomb_edge_error() -> f64 {
 /// σ_y = 2.5e4, h = 1, at its last step), by `tests/verification/fbar.rs`'s check and increment, with
 /// `bug` switched on for the check only (the steps before it are solved correctly).
 fn fbar_tangent_error(bug: Bug) -> f64 {
+    fbar_tangent_error_with(bug, false)
+}
+
+/// F-bar's FD tangent error on the compaction block with `bug`, the pressure projection on
+/// or off (tests/verification/fbar.rs).
+fn fbar_tangent_error_with(bug: Bug, project_pressure: bool) -> f64 {
     use igimp::material::constitutive::Material;
     use igimp::problems::compaction::CompactionSpec;
     use igimp::solver::load_stepping::LoadStepping;
@@ -349,6 +355,7 @@ fn fbar_tangent_error(bug: Bug) -> f64 {
         ..Default::default()
     };
     let mut solver = spec.mpm_solver().unwrap();
+    solver.set_pressure_projection(project_pressure);
     for _ in 0..9 {
         solver.step().unwrap();
     }
@@ -519,6 +526,17 @@ fn every_seeded_bug_is_caught() {
     assert!(
         wrong > 1e-6,
         "Cam-Clay's tangent without hardening passed: {wrong:e}"
+    );
+
+    // 15. The pressure projection's tangent without its patch block: the finite-difference
+    //     check of tests/verification/fbar.rs (1e-6) fails.
+    let right = fbar_tangent_error_with(Bug::None, true);
+    let wrong = fbar_tangent_error_with(Bug::PressureProjectionWithoutItsBlock, true);
+    eprintln!("pressure projection without its block: FD error {wrong:.2e} (correct {right:.1e})");
+    assert!(right < 1e-6, "the correct projected tangent is off by {right:e}");
+    assert!(
+        wrong > 1e-6,
+        "the projected tangent without its block passed: {wrong:e}"
     );
 
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.

@@ -293,6 +293,12 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
         &self.core.work.table
     }
 
+    /// With F-bar on, also give each element's Gauss points the element's mean pressure
+    /// (reference/README.md item 75).
+    pub fn set_pressure_projection(&mut self, on: bool) {
+        self.core.work.f_bar.project_pressure = on;
+    }
+
     /// Set up the nonlinear system of a load step at `load_factor` on the current mesh and
     /// committed states and hand it to `f` (tests probe residual and tangent through it).
     pub fn with_step_system<R>(

@@ -222,6 +222,38 @@ pub fn spatial_tangent_eigen<const D: usize>(
     a
 }
 
+/// The trace over all three axes of [`spatial_tangent_eigen`]'s material part: T_kl =
+/// Σ_m (D^alg : ½L:B_kl)_mm / J for in-plane k, l, the rate of tr τ / J per ∂Δu_k/∂x_l. The
+/// spatial tangent keeps only in-plane rows; the pressure projection needs the out-of-plane
+/// one too (reference/README.md item 75).
+pub fn spatial_trace_tangent<const D: usize>(
+    d_alg: &Tensor4,
+    lam: &Vector3<f64>,
+    q: &Matrix3<f64>,
+    j: f64,
+) -> Matrix3<f64> {
+    let theta = log_divided_differences(lam);
+    let mut t = Matrix3::zeros();
+    for k in 0..D {
+        for l in 0..D {
+            let hat = Matrix3::from_fn(|x, y| {
+                0.5 * theta[(x, y)] * (q[(k, x)] * q[(l, y)] * lam[y] + q[(l, x)] * q[(k, y)] * lam[x])
+            });
+            let de = q * hat * q.transpose();
+            let mut s = 0.0;
+            for a in 0..3 {
+                for m in 0..3 {
+                    for n in 0..3 {
+                        s += d_alg[(ij(a, a), ij(m, n))] * de[(m, n)];
+                    }
+                }
+            }
+            t[(k, l)] = s / j;
+        }
+    }
+    t
+}
+
 /// Embed a `D×D` displacement-gradient block into the 3×3 deformation-gradient increment
 /// ΔF = I + ∂Δu/∂X̃, eq (31).
 #[inline]

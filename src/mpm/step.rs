@@ -113,6 +113,12 @@ impl<const D: usize> MpmSolver<D> {
         })
     }
 
+    /// With F-bar on, also give each cell's points the cell's mean pressure
+    /// ([`crate::discretise::assembly`]'s pressure projection, reference/README.md item 75).
+    pub fn set_pressure_projection(&mut self, on: bool) {
+        self.work.f_bar.project_pressure = on;
+    }
+
     /// The nonlinear system of the next load step at `load_factor` (unknowns: the nodal
     /// displacement increment from the committed state), for evaluations outside Newton, e.g.
     /// the residual of a prescribed field. Nothing is committed.

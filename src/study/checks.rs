@@ -59,6 +59,57 @@ pub fn check_rate(
     )
 }
 
+/// Newton converges quadratically: once a normalised residual is at most `small`, the next one
+/// above `floor` is at most `constant` times its square, and where three successive residuals
+/// qualify the observed order is at least 1.5 ([`crate::solver::newton::check_quadratic`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadraticExpectation {
+    pub small: f64,
+    pub floor: f64,
+    pub constant: f64,
+    pub source: String,
+}
+
+/// The check `id` of `q` over `steps` (case id, step, its residual history; `what` and
+/// `scope` word its description): measured is the
+/// largest r_(k+1)/r_k² among the residuals it applies to; it fails on any violation, named
+/// with its case and step, and is not evaluated where no step reached `small` twice.
+pub fn check_newton_quadratic<'a>(
+    id: &str,
+    what: &str,
+    scope: &str,
+    steps: impl Iterator<Item = (&'a str, usize, &'a [f64])>,
+    q: &QuadraticExpectation,
+) -> CheckRecord {
+    let mut worst: Option<f64> = None;
+    let mut failure = None;
+    for (case, step, residuals) in steps {
+        match crate::solver::newton::check_quadratic(residuals, q.small, q.floor, q.constant, 1.5) {
+            Ok(k) if k.ratio_checks > 0 => worst = Some(worst.unwrap_or(0.0).max(k.max_ratio)),
+            Ok(_) => {}
+            Err(m) => failure = failure.or(Some(format!("{case} step {step}: {m}"))),
+        }
+    }
+    let mut rec = check_at_most(
+        id,
+        format!(
+            "{what}: once r_k ≤ {:e}, r_(k+1) ≤ {} r_k² above {:e} and the observed order ≥ 1.5, every step of {scope} (measured: the largest r_(k+1)/r_k²{})",
+            q.small,
+            q.constant,
+            q.floor,
+            failure.as_ref().map_or(String::new(), |f| format!("; violated at {f}"))
+        ),
+        worst,
+        q.constant,
+        &q.source,
+    );
+    if failure.is_some() {
+        rec.pass = Some(false);
+    }
+    rec
+}
+
 /// (passed, failed, not evaluated).
 pub fn check_counts(checks: &[CheckRecord]) -> (usize, usize, usize) {
     let mut n = (0, 0, 0);

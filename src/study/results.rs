@@ -77,6 +77,25 @@ pub struct FailureRecord {
     pub residuals: Vec<f64>,
 }
 
+impl SolveRecord {
+    /// Every step's residual history as (case, step, residuals), a failed case's last
+    /// attempt included: a tangent off its derivative often makes Newton so slow that the
+    /// case fails, and its residuals are then the evidence (the Newton-order checks).
+    pub fn newton_histories<'a>(
+        &'a self,
+        case: &'a str,
+    ) -> impl Iterator<Item = (&'a str, usize, &'a [f64])> {
+        let failed = self
+            .failure
+            .iter()
+            .map(move |f| (case, f.step, f.residuals.as_slice()));
+        self.steps
+            .iter()
+            .map(move |s| (case, s.step, s.residuals.as_slice()))
+            .chain(failed)
+    }
+}
+
 /// Residual histories of converged load steps.
 pub fn step_records(steps: &[StepReport]) -> Vec<StepRecord> {
     steps

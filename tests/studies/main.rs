@@ -13,6 +13,7 @@ mod element_study;
 mod external;
 mod figures;
 mod first_contact;
+mod footing_newton;
 mod manufactured3d_study;
 mod manufactured_dynamic_study;
 mod manufactured_study;

@@ -51,6 +51,7 @@ fn small(load_steps: usize, newton: NewtonSettings, gamma: f64) -> SceneSettings
         domain_update: Default::default(),
         linear_solver: Default::default(),
         f_bar: false,
+        pressure_projection: false,
         gauss_points: None,
     }
 }
@@ -90,6 +91,7 @@ fn the_compaction_as_a_scene_is_the_compaction() {
                 domain_update: spec.domain_update,
                 linear_solver: spec.linear_solver,
                 f_bar: false,
+                pressure_projection: false,
                 gauss_points: None,
             };
             let o = scene::solve(&s, &settings, method).unwrap();

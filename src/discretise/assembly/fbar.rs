@@ -29,8 +29,13 @@ pub struct FBarScratch {
     scale: Vec<f64>,
     /// Each patch's ΔJ̄_c at the last evaluation.
     patch_dj: Vec<f64>,
-    /// Each point's q = D^alg : I_D / (D J̄) at the last tangent.
+    /// Each point's q = D^alg : I_D / (D J̄) at the last tangent (with the pressure projection
+    /// also its out-of-plane diagonal).
     q: Vec<Matrix3<f64>>,
+    /// Whether each patch's points carry its mean Kirchhoff pressure ([`super::pressure`]).
+    pub project_pressure: bool,
+    /// With the projection, each point's trace tangent T (in-plane block) at the last tangent.
+    trace: Vec<Matrix3<f64>>,
     /// The step's patch layout: what a patch block's rows and columns are, fixed within a
     /// step (the supports and equations are), so formed once per step, not per thread and
     /// iteration.
@@ -188,24 +193,18 @@ impl<'a> FBar<'a> {
         states: &[PointState],
         trials: &[Option<PointTrial<D>>],
     ) {
+        let project = self.scratch.project_pressure;
         let q = &mut self.scratch.q;
         q.resize(states.len(), Matrix3::zeros());
+        let trace = &mut self.scratch.trace;
+        trace.resize(if project { states.len() } else { 0 }, Matrix3::zeros());
+        if project {
+            super::pressure::form_trace::<D>(model, states, trials, q, trace);
+            return;
+        }
         q.par_iter_mut().enumerate().for_each(|(p, qp)| {
             let t = trials[p].as_ref().expect("evaluated");
-            let eps = if model.tangent_reads_strain() {
-                t.eps_trial()
-            } else {
-                Matrix3::zeros()
-            };
-            let d_alg = model.tangent(&eps, &states[p].material);
-            let scale = 1.0 / (D as f64 * t.j);
-            *qp = Matrix3::from_fn(|i, j| {
-                if i < D && j < D {
-                    scale * (0..D).map(|m| d_alg[(ij(i, j), ij(m, m))]).sum::<f64>()
-                } else {
-                    0.0
-                }
-            });
+            *qp = point_q::<D>(model, &states[p], t, false).0;
         });
     }
 
@@ -216,6 +215,18 @@ impl<'a> FBar<'a> {
             dj: &self.scratch.dj,
             q: &self.scratch.q,
             layout: &self.scratch.layout,
+            trace: self.scratch.project_pressure.then_some(&self.scratch.trace[..]),
+        }
+    }
+
+    /// With the pressure projection on, give each shared patch's points its mean pressure.
+    pub(super) fn project<const D: usize>(
+        &self,
+        states: &[PointState],
+        trials: &mut [Option<PointTrial<D>>],
+    ) {
+        if self.scratch.project_pressure {
+            super::pressure::project_residual(self.patches, states, trials);
         }
     }
 }
@@ -227,6 +238,8 @@ pub(super) struct FBarView<'a> {
     dj: &'a [f64],
     q: &'a [Matrix3<f64>],
     layout: &'a PatchLayout,
+    /// The trace tangents, with the pressure projection on.
+    trace: Option<&'a [Matrix3<f64>]>,
 }
 
 /// Most nodes a patch's points touch: a cell's points reach at most 4 nodes per axis beyond
@@ -253,13 +266,52 @@ impl FBarView<'_> {
                 }
             }
         }
+        if let Some(trace) = self.trace {
+            // The projection keeps the point's deviatoric rate only: −δ_ij T_kl / 3.
+            let t = &trace[p];
+            for i in 0..D {
+                for k in 0..D {
+                    for l in 0..D {
+                        a[(ij(i, i), ij(k, l))] -= t[(k, l)] / 3.0;
+                    }
+                }
+            }
+        }
     }
 }
 
-/// One patch's rank-one block r gᵀ over its nodes' dofs (the layout's order).
+/// Point `t`'s q = D^alg : I_D / (D J̄) (in-plane; with `out_of_plane`, its out-of-plane
+/// diagonal too) and the D^alg it is formed from.
+pub(super) fn point_q<const D: usize>(
+    model: &dyn ConstitutiveModel,
+    state: &PointState,
+    t: &PointTrial<D>,
+    out_of_plane: bool,
+) -> (Matrix3<f64>, crate::material::tensor::Tensor4) {
+    let eps = if model.tangent_reads_strain() {
+        t.eps_trial()
+    } else {
+        Matrix3::zeros()
+    };
+    let d_alg = model.tangent(&eps, &state.material);
+    let scale = 1.0 / (D as f64 * t.j);
+    let q = Matrix3::from_fn(|i, j| {
+        if (i < D && j < D) || (out_of_plane && i == j) {
+            scale * (0..D).map(|m| d_alg[(ij(i, j), ij(m, m))]).sum::<f64>()
+        } else {
+            0.0
+        }
+    });
+    (q, d_alg)
+}
+
+/// One patch's block r gᵀ over its nodes' dofs (the layout's order), plus R Pᵀ with the
+/// pressure projection ([`super::pressure`]).
 pub(super) struct PatchBlock {
     r: Vec<f64>,
     g: Vec<f64>,
+    r2: Vec<f64>,
+    g2: Vec<f64>,
 }
 
 impl PatchBlock {
@@ -267,6 +319,8 @@ impl PatchBlock {
         Self {
             r: Vec::with_capacity(MAX_PATCH_NODES * 3),
             g: Vec::with_capacity(MAX_PATCH_NODES * 3),
+            r2: Vec::new(),
+            g2: Vec::new(),
         }
     }
 
@@ -292,7 +346,11 @@ impl PatchBlock {
             let m = spatial_gradients(table, p, t, &mut gx);
             let w = states[p].volume * f.dj[p];
             weight += w;
-            let q = &f.q[p];
+            // With the projection the Ḡ part's trace goes to the patch pressure (R Pᵀ).
+            let q = &match f.trace {
+                Some(_) => super::pressure::deviator(&f.q[p]),
+                None => f.q[p],
+            };
             for (k, &node) in table.point(p).0[..m].iter().enumerate() {
                 let local = nodes.binary_search(&node).expect("a patch node") * D;
                 for i in 0..D {
@@ -303,6 +361,22 @@ impl PatchBlock {
             }
         }
         self.g.iter_mut().for_each(|x| *x /= weight);
+        self.r2.clear();
+        self.g2.clear();
+        if let Some(trace) = f.trace {
+            super::pressure::form_block(
+                f.patches.points(c),
+                table,
+                trials,
+                states,
+                f.q,
+                trace,
+                nodes,
+                &self.g,
+                &mut self.r2,
+                &mut self.g2,
+            );
+        }
     }
 }
 
@@ -326,23 +400,22 @@ pub(super) fn add_patches<const D: usize>(
             continue;
         }
         patch.form(f, table, trials, states, c, nodes);
-        // K = r gᵀ; stored by rows the lines are K's rows, so the roles swap.
-        let (line_factor, entries) = if block.by_rows() {
-            (&patch.r, &patch.g)
-        } else {
-            (&patch.g, &patch.r)
-        };
-        for (ci, col) in eqs.iter().enumerate() {
-            let Some(col) = col.filter(owned) else { continue };
-            let factor = line_factor[ci];
-            if factor == 0.0 {
-                continue;
-            }
-            let mut hint = usize::MAX;
-            for s in stretches {
-                let values = block.stretch_with_hint(s.row, col, s.len, &mut hint);
-                for (x, e) in values.iter_mut().zip(&entries[s.local..s.local + s.len]) {
-                    *x += e * factor;
+        // K = r gᵀ (+ R Pᵀ); stored by rows the lines are K's rows, so the roles swap.
+        let pairs = [(&patch.r, &patch.g), (&patch.r2, &patch.g2)];
+        for (r, g) in pairs.into_iter().filter(|(r, _)| !r.is_empty()) {
+            let (line_factor, entries) = if block.by_rows() { (r, g) } else { (g, r) };
+            for (ci, col) in eqs.iter().enumerate() {
+                let Some(col) = col.filter(owned) else { continue };
+                let factor = line_factor[ci];
+                if factor == 0.0 {
+                    continue;
+                }
+                let mut hint = usize::MAX;
+                for s in stretches {
+                    let values = block.stretch_with_hint(s.row, col, s.len, &mut hint);
+                    for (x, e) in values.iter_mut().zip(&entries[s.local..s.local + s.len]) {
+                        *x += e * factor;
+                    }
                 }
             }
         }
@@ -374,7 +447,12 @@ pub(super) fn linearised_rows<const D: usize>(
             let dof = nodes[ri / D] * D + ri % D;
             for (ci, col) in eqs.iter().enumerate() {
                 if let Some(col) = *col {
-                    rows.push((dof, col, patch.r[ri] * patch.g[ci]));
+                    let extra = if patch.r2.is_empty() {
+                        0.0
+                    } else {
+                        patch.r2[ri] * patch.g2[ci]
+                    };
+                    rows.push((dof, col, patch.r[ri] * patch.g[ci] + extra));
                 }
             }
         }

@@ -122,6 +122,9 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         if let Some((point, reason)) = first_error {
             return Err(StepFailure::Kinematics { point, reason });
         }
+        if let Some(f) = self.f_bar.as_ref() {
+            f.project(self.states, self.trials);
+        }
         f_int.iter_mut().for_each(|v| *v = 0.0);
         self.fixed_forces.clear();
         self.fixed_forces.resize(self.dofs.num_dofs(), 0.0);

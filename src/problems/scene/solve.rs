@@ -300,6 +300,7 @@ fn solve_mpm<const D: usize>(
     let discrete = super::discrete::DiscreteScene::of(scene, s)?;
     let named = discrete.named_dofs();
     let mut solver = discrete.solver::<D>(basis, s)?;
+    solver.set_pressure_projection(s.f_bar && s.pressure_projection);
     let measure = |solver: &MpmSolver<D>| {
         let pts = &solver.points;
         let displacement = |at: &[f64], axis: usize, edge: bool| {
@@ -388,6 +389,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
         nodal_forces: traction_nodal_forces(scene, &mesh, h)?,
     };
     let mut fem = ContinuumFem::try_new(mesh, body.density, model, fixed, loads, settings)?;
+    fem.set_pressure_projection(s.f_bar && s.pressure_projection);
     if let Some(b) = tabled {
         fem.set_body_force(b);
     }

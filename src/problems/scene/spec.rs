@@ -527,6 +527,10 @@ pub struct SceneSettings {
     /// F-bar over each cell (material points) or element (FEM); reference/README.md item 69.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub f_bar: bool,
+    /// With F-bar, every cell's or element's points carry its mean pressure (reference/README.md
+    /// item 75).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub pressure_projection: bool,
     /// Gauss points per axis of a FEM case (`None`: the element's default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gauss_points: Option<usize>,

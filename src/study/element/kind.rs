@@ -5,7 +5,7 @@
 use super::{ClosedFormRecord, ElementMeasures, ElementRecord, ElementResults, ElementStudy, TestSection};
 use crate::problems::element_test::closed_form::measures;
 use crate::problems::element_test::{run, ElementState};
-use crate::study::checks::{check_at_most, CheckRecord};
+use crate::study::checks::{check_at_most, check_newton_quadratic, CheckRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::results::{CaseStatus, FailureRecord, SolveRecord, StepRecord, SweepIndex};
 use crate::study::{StudyError, Tier};
@@ -188,40 +188,16 @@ fn checks(results: &ElementResults) -> Vec<CheckRecord> {
         ));
     }
     if let Some(q) = &study.expect_quadratic {
-        // Every step of every converged test; not evaluated if no step iterated twice.
-        let mut worst: Option<f64> = None;
-        let mut failure = None;
-        for c in results
-            .cases
-            .iter()
-            .filter(|c| c.solve.status == CaseStatus::Converged)
-        {
-            for s in &c.solve.steps {
-                match crate::solver::newton::check_quadratic(&s.residuals, q.small, q.floor, q.constant, 1.5)
-                {
-                    Ok(k) if k.ratio_checks > 0 => worst = Some(worst.unwrap_or(0.0).max(k.max_ratio)),
-                    Ok(_) => {}
-                    Err(m) => failure = failure.or(Some(format!("{} step {}: {m}", c.id, s.step))),
-                }
-            }
-        }
-        let mut rec = check_at_most(
+        // Every step of every test, a failed test's last attempt included; not evaluated if
+        // no step iterated twice.
+        let steps = results.cases.iter().flat_map(|c| c.solve.newton_histories(&c.id));
+        out.push(check_newton_quadratic(
             "newton-quadratic",
-            format!(
-                "Newton on the stress-controlled components: once r_k ≤ {:e}, r_(k+1) ≤ {} r_k² above {:e} and the observed order ≥ 1.5, every step of every test (measured: the largest r_(k+1)/r_k²{})",
-                q.small,
-                q.constant,
-                q.floor,
-                failure.as_ref().map_or(String::new(), |f| format!("; violated at {f}"))
-            ),
-            worst,
-            q.constant,
-            &q.source,
-        );
-        if failure.is_some() {
-            rec.pass = Some(false);
-        }
-        out.push(rec);
+            "Newton on the stress-controlled components",
+            "every test",
+            steps,
+            q,
+        ));
     }
     out
 }

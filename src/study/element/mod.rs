@@ -8,6 +8,7 @@ mod kind;
 use super::material::MaterialTable;
 use super::vocabulary::{Checker, ExpectedFailure, Header};
 use crate::problems::element_test::{ClosedForm, ElementPath, ElementTest};
+use crate::study::checks::QuadraticExpectation;
 use crate::study::results::{case_record, Envelope, SolveRecord};
 use crate::study::StudyError;
 use serde::{Deserialize, Serialize};
@@ -66,18 +67,6 @@ pub struct ClosedFormExpectation {
     pub test: String,
     pub closed_form: ClosedForm,
     pub tolerance: f64,
-    pub source: String,
-}
-
-/// Newton on the stress-controlled components converges quadratically: once a normalised
-/// residual is at most `small`, the next one above `floor` is at most `constant` times its
-/// square ([`crate::solver::newton::check_quadratic`]), in every step of every test.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct QuadraticExpectation {
-    pub small: f64,
-    pub floor: f64,
-    pub constant: f64,
     pub source: String,
 }
 

@@ -5,7 +5,7 @@
 
 use super::{RateRecord, ReferenceValue, SceneCase, SceneMeasures, SceneRecord, SceneResults, SceneStudy};
 use crate::problems::scene::{solve, ClosedForm, Scene};
-use crate::study::checks::{check_at_most, check_rate, CheckRecord, GciRecord};
+use crate::study::checks::{check_at_most, check_newton_quadratic, check_rate, CheckRecord, GciRecord};
 use crate::study::engine::{study_file_fields, CaseKey, Results, StudyKind, VtkTarget};
 use crate::study::external::{self, StudyMethod};
 use crate::study::results::{CaseStatus, SolveRecord, SweepIndex};
@@ -391,6 +391,20 @@ fn checks(results: &SceneResults) -> Vec<CheckRecord> {
             worst,
             e.tolerance,
             &e.source,
+        ));
+    }
+    for e in &study.expect_quadratic {
+        let cases = results.sweep(&e.sweep);
+        if cases.is_empty() {
+            continue; // not run in this tier
+        }
+        let steps = cases.into_iter().flat_map(|c| c.solve.newton_histories(&c.id));
+        out.push(check_newton_quadratic(
+            &format!("{}-newton-quadratic", e.sweep),
+            &format!("Newton in sweep {}", e.sweep),
+            "every case (a failed case's last attempt included)",
+            steps,
+            &e.terms(),
         ));
     }
     let extent = scene_extent(study);

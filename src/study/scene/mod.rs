@@ -52,6 +52,10 @@ pub struct SceneSweep {
     /// F-bar for every case (ids gain `-fbar`; reference/README.md item 69).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub f_bar: bool,
+    /// With `f_bar`, each cell's or element's points carry its mean pressure (ids gain `-p`;
+    /// reference/README.md item 75).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub pressure_projection: bool,
     /// Gauss points per axis of the FEM cases (1..=5; default: the element's own, 2 for
     /// Q4/Hex8 and 3 for Q8/Hex20); their ids gain `-gp<n>`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -84,6 +88,30 @@ pub struct ReferenceExpectation {
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub finest: bool,
     pub source: String,
+}
+
+/// Newton converges quadratically in every step of every converged case of `sweep`
+/// ([`crate::study::checks::QuadraticExpectation`]'s terms).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadraticSweepExpectation {
+    pub sweep: String,
+    pub small: f64,
+    pub floor: f64,
+    pub constant: f64,
+    pub source: String,
+}
+
+impl QuadraticSweepExpectation {
+    /// The terms of the check.
+    pub fn terms(&self) -> crate::study::checks::QuadraticExpectation {
+        crate::study::checks::QuadraticExpectation {
+            small: self.small,
+            floor: self.floor,
+            constant: self.constant,
+            source: self.source.clone(),
+        }
+    }
 }
 
 /// Two methods of `sweep` agree point by point: at every element size and points per cell
@@ -146,6 +174,8 @@ pub struct SceneStudy {
     pub expect_rate: Vec<RateExpectation>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub expect_agreement: Vec<AgreementExpectation>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expect_quadratic: Vec<QuadraticSweepExpectation>,
 }
 
 /// One case to solve.
@@ -295,6 +325,7 @@ impl SceneStudy {
             domain_update: Default::default(),
             linear_solver: s.linear_solver.unwrap_or_default(),
             f_bar: s.f_bar,
+            pressure_projection: s.pressure_projection,
             gauss_points: s.gauss_points.map(|n| n as usize),
         }
     }
@@ -315,6 +346,9 @@ impl SceneStudy {
         }
         if s.f_bar {
             id.push_str("-fbar");
+        }
+        if s.pressure_projection {
+            id.push_str("-p");
         }
         if let (Some(n), false) = (s.gauss_points, method.uses_material_points()) {
             id.push_str(&format!("-gp{n}"));

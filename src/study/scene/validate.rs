@@ -57,6 +57,13 @@ impl SceneStudy {
         for (i, s) in self.sweeps.iter().enumerate() {
             chk.unique_ident(&format!("sweeps[{i}].id"), &s.id, &mut ids)?;
             chk.text(&format!("sweeps[{i}].title"), &s.title)?;
+            if s.pressure_projection && !s.f_bar {
+                return Err(chk.err(
+                    format!("sweeps[{i}].pressure_projection"),
+                    "true",
+                    "needs f_bar = true in the same sweep",
+                ));
+            }
             if let Some(n) = s.gauss_points {
                 chk.count(&format!("sweeps[{i}].gauss_points"), n, 1, 5)?;
             }
@@ -224,6 +231,14 @@ impl SceneStudy {
                 ));
             }
             chk.positive(&format!("{key}.tolerance"), e.tolerance)?;
+            chk.text(&format!("{key}.source"), &e.source)?;
+        }
+        for (i, e) in self.expect_quadratic.iter().enumerate() {
+            let key = format!("expect_quadratic[{i}]");
+            sweep(&format!("{key}.sweep"), &e.sweep)?;
+            for (k, v) in [("small", e.small), ("floor", e.floor), ("constant", e.constant)] {
+                chk.positive(&format!("{key}.{k}"), v)?;
+            }
             chk.text(&format!("{key}.source"), &e.source)?;
         }
         Ok(())
