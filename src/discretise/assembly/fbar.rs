@@ -204,7 +204,7 @@ impl<'a> FBar<'a> {
         }
         q.par_iter_mut().enumerate().for_each(|(p, qp)| {
             let t = trials[p].as_ref().expect("evaluated");
-            *qp = point_q::<D>(model, &states[p], t, false).0;
+            *qp = super::local::point_q::<D>(model, &states[p], t, false).0;
         });
     }
 
@@ -278,31 +278,6 @@ impl FBarView<'_> {
             }
         }
     }
-}
-
-/// Point `t`'s q = D^alg : I_D / (D J̄) (in-plane; with `out_of_plane`, its out-of-plane
-/// diagonal too) and the D^alg it is formed from.
-pub(super) fn point_q<const D: usize>(
-    model: &dyn ConstitutiveModel,
-    state: &PointState,
-    t: &PointTrial<D>,
-    out_of_plane: bool,
-) -> (Matrix3<f64>, crate::material::tensor::Tensor4) {
-    let eps = if model.tangent_reads_strain() {
-        t.eps_trial()
-    } else {
-        Matrix3::zeros()
-    };
-    let d_alg = model.tangent(&eps, &state.material);
-    let scale = 1.0 / (D as f64 * t.j);
-    let q = Matrix3::from_fn(|i, j| {
-        if (i < D && j < D) || (out_of_plane && i == j) {
-            scale * (0..D).map(|m| d_alg[(ij(i, j), ij(m, m))]).sum::<f64>()
-        } else {
-            0.0
-        }
-    });
-    (q, d_alg)
 }
 
 /// One patch's block r gᵀ over its nodes' dofs (the layout's order), plus R Pᵀ with the

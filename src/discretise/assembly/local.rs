@@ -1,10 +1,13 @@
 //! What a dense block of the tangent is made of and how it is scattered: a point's spatial
 //! gradients (eq 36), and a block's equations as stretches of consecutive ones. Shared by the
-//! point kernels ([`super::kernel`]) and F-bar's patch blocks ([`super::fbar`]).
+//! point kernels ([`super::kernel`]), F-bar's patch blocks ([`super::fbar`]) and the pressure
+//! projection ([`super::pressure`]), with the point's F-bar q both of the latter read.
 
 use crate::discretise::dofs::{SupportTable, MAX_POINT_NODES};
-use crate::material::kinematics::PointTrial;
-use nalgebra::SVector;
+use crate::material::constitutive::ConstitutiveModel;
+use crate::material::kinematics::{PointState, PointTrial};
+use crate::material::tensor::ij;
+use nalgebra::{Matrix3, SVector};
 
 /// ∂S/∂x_j = ∂S/∂X̃_i (ΔF⁻¹)_ij (eq 36) of point `p`'s nodes at trial `t` into `gx`; returns
 /// the node count.
@@ -50,4 +53,29 @@ pub(super) fn row_stretches(eqs: &[Option<usize>], out: &mut Vec<RowStretch>) {
         }
     }
     out.extend(open);
+}
+
+/// Point `t`'s q = D^alg : I_D / (D J̄) (in-plane; with `out_of_plane`, its out-of-plane
+/// diagonal too) and the D^alg it is formed from.
+pub(super) fn point_q<const D: usize>(
+    model: &dyn ConstitutiveModel,
+    state: &PointState,
+    t: &PointTrial<D>,
+    out_of_plane: bool,
+) -> (Matrix3<f64>, crate::material::tensor::Tensor4) {
+    let eps = if model.tangent_reads_strain() {
+        t.eps_trial()
+    } else {
+        Matrix3::zeros()
+    };
+    let d_alg = model.tangent(&eps, &state.material);
+    let scale = 1.0 / (D as f64 * t.j);
+    let q = Matrix3::from_fn(|i, j| {
+        if (i < D && j < D) || (out_of_plane && i == j) {
+            scale * (0..D).map(|m| d_alg[(ij(i, j), ij(m, m))]).sum::<f64>()
+        } else {
+            0.0
+        }
+    });
+    (q, d_alg)
 }

@@ -72,7 +72,7 @@ pub(super) fn form_trace<const D: usize>(
         .enumerate()
         .for_each(|(p, (qp, tp))| {
             let t = trials[p].as_ref().expect("evaluated");
-            let (qt, d_alg) = super::fbar::point_q::<D>(model, &states[p], t, true);
+            let (qt, d_alg) = super::local::point_q::<D>(model, &states[p], t, true);
             *qp = qt;
             let mut tr =
                 spatial_trace_tangent::<D>(&d_alg, &t.b_trial_eigenvalues, &t.b_trial_eigenvectors, t.j);
