@@ -18,6 +18,9 @@ use nalgebra::Matrix3;
 use rayon::prelude::*;
 use std::hint::black_box;
 
+#[path = "../tests/verification/scene_text.rs"]
+mod scene_text;
+
 fn materials() -> Vec<(&'static str, Material)> {
     let friction = |model: &str| {
         Material::new(
@@ -57,31 +60,16 @@ fn materials() -> Vec<(&'static str, Material)> {
 }
 
 fn block(material: Material) -> scene::Scene {
-    #[derive(serde::Deserialize)]
-    struct Parts {
-        grid: scene::GridSection,
-        bodies: Vec<scene::Body>,
-        supports: Vec<scene::Support>,
-        loads: Vec<scene::Load>,
-    }
-    let p: Parts = toml::from_str(
+    scene_text::scene(
+        2,
         r#"
 grid = { origin = [0.0, 0.0], extent = [5.0, 4.0] }
 bodies = [{ name = "soil", box = { min = [0.0, 0.0], max = [5.0, 3.0] }, material = "m" }]
 supports = [{ name = "base", plane = { axis = "y", at = 0.0 }, fix = ["x", "y"] }]
 loads = [{ kind = "gravity", vector = [0.0, -1.0] }]
 "#,
+        material,
     )
-    .unwrap();
-    scene::Scene {
-        dimension: 2,
-        grid: p.grid,
-        materials: [("m".to_string(), material)].into_iter().collect(),
-        bodies: p.bodies,
-        supports: p.supports,
-        loads: p.loads,
-        measures: vec![],
-    }
 }
 
 fn residual_2d(c: &mut Criterion) {

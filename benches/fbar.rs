@@ -15,15 +15,12 @@ use igimp::problems::scene::{self, DiscreteScene, SceneSettings};
 use igimp::solver::newton::NonlinearSystem;
 use std::hint::black_box;
 
+#[path = "../tests/verification/scene_text.rs"]
+mod scene_text;
+
 fn footing() -> scene::Scene {
-    #[derive(serde::Deserialize)]
-    struct Parts {
-        grid: scene::GridSection,
-        bodies: Vec<scene::Body>,
-        supports: Vec<scene::Support>,
-        loads: Vec<scene::Load>,
-    }
-    let p: Parts = toml::from_str(
+    scene_text::scene(
+        2,
         r#"
 grid = { origin = [0.0, 0.0], extent = [5.0, 4.0] }
 bodies = [{ name = "soil", box = { min = [0.0, 0.0], max = [5.0, 3.0] }, material = "m" }]
@@ -34,19 +31,8 @@ supports = [
 ]
 loads = [{ kind = "displacement", name = "footing", box = { min = [0.0, 3.0], max = [0.5, 3.0] }, displacement = { y = -0.02 } }]
 "#,
+        Material::von_mises(1e4, 0.49, 3f64.sqrt()),
     )
-    .unwrap();
-    scene::Scene {
-        dimension: 2,
-        grid: p.grid,
-        materials: [("m".to_string(), Material::von_mises(1e4, 0.49, 3f64.sqrt()))]
-            .into_iter()
-            .collect(),
-        bodies: p.bodies,
-        supports: p.supports,
-        loads: p.loads,
-        measures: vec![],
-    }
 }
 
 /// Residual and tangent of `sys` at the increment `u`, each as one benchmark.

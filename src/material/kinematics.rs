@@ -166,6 +166,23 @@ pub fn spatial_tangent<const D: usize>(
     a
 }
 
+/// The strain rate ½ L : B : (e_k ⊗ e_l) from the eigenbasis `q` of the trial b^e, its
+/// eigenvalues `lam` and Θ = `theta`, their divided differences of ln:
+/// (Qᵀ ½L:B_kl Q)_ab = ½ Θ_ab (Q_ka Q_lb λ_b + Q_la Q_kb λ_a).
+#[inline(always)]
+fn log_strain_rate(
+    theta: &Matrix3<f64>,
+    lam: &Vector3<f64>,
+    q: &Matrix3<f64>,
+    k: usize,
+    l: usize,
+) -> Matrix3<f64> {
+    let hat = Matrix3::from_fn(|x, y| {
+        0.5 * theta[(x, y)] * (q[(k, x)] * q[(l, y)] * lam[y] + q[(l, x)] * q[(k, y)] * lam[x])
+    });
+    q * hat * q.transpose()
+}
+
 /// Spatial tangent of eq (25) without forming L: for each active (k, l), the strain rate
 /// ½ L : B : (e_k ⊗ e_l) is evaluated in the eigenbasis of the trial b^e, where with
 /// b = Q Λ Qᵀ and Θ the divided differences of ln,
@@ -187,10 +204,7 @@ pub fn spatial_tangent_eigen<const D: usize>(
     let dm = if block { D } else { 3 };
     for k in 0..D {
         for l in 0..D {
-            let hat = Matrix3::from_fn(|x, y| {
-                0.5 * theta[(x, y)] * (q[(k, x)] * q[(l, y)] * lam[y] + q[(l, x)] * q[(k, y)] * lam[x])
-            });
-            let de = q * hat * q.transpose();
+            let de = log_strain_rate(&theta, lam, q, k, l);
             let col = ij(k, l);
             // D^alg : de for all nine rows at once, column by column of D^alg (contiguous)
             // in the order r = ij(m, n) ascending: each row's sum takes its products in the
@@ -236,10 +250,7 @@ pub fn spatial_trace_tangent<const D: usize>(
     let mut t = Matrix3::zeros();
     for k in 0..D {
         for l in 0..D {
-            let hat = Matrix3::from_fn(|x, y| {
-                0.5 * theta[(x, y)] * (q[(k, x)] * q[(l, y)] * lam[y] + q[(l, x)] * q[(k, y)] * lam[x])
-            });
-            let de = q * hat * q.transpose();
+            let de = log_strain_rate(&theta, lam, q, k, l);
             let mut s = 0.0;
             for a in 0..3 {
                 for m in 0..3 {

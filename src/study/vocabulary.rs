@@ -219,6 +219,20 @@ impl Checker<'_> {
             Err(self.err(key, format!("{v:?}"), format!("must be {IDENT_RULE}")))
         }
     }
+
+    /// A Newton-order check's terms at `key`: `small`, `floor` and `constant` positive, a
+    /// source given.
+    pub fn quadratic(
+        &self,
+        key: &str,
+        q: &crate::study::checks::QuadraticExpectation,
+    ) -> Result<(), StudyError> {
+        for (k, v) in [("small", q.small), ("floor", q.floor), ("constant", q.constant)] {
+            self.positive(&format!("{key}.{k}"), v)?;
+        }
+        self.text(&format!("{key}.source"), &q.source)
+    }
+
     pub fn text(&self, key: &str, v: &str) -> Result<(), StudyError> {
         if v.trim().is_empty() {
             Err(self.err(key, "\"\"", "must not be empty"))

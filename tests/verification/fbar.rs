@@ -203,15 +203,8 @@ fn fbar_tangent_matches_central_differences_under_a_footing() {
 /// The strip footing on a 2 × 1.5 block of von Mises soil (c = 1, E = 1e4, ν = 0.49), half
 /// of a 1-wide footing settling by 0.02.
 fn footing_scene() -> igimp::problems::scene::Scene {
-    use igimp::problems::scene;
-    #[derive(serde::Deserialize)]
-    struct Parts {
-        grid: scene::GridSection,
-        bodies: Vec<scene::Body>,
-        supports: Vec<scene::Support>,
-        loads: Vec<scene::Load>,
-    }
-    let p: Parts = toml::from_str(
+    crate::scene_text::scene(
+        2,
         r#"
 grid = { origin = [0.0, 0.0], extent = [2.0, 2.0] }
 bodies = [{ name = "soil", box = { min = [0.0, 0.0], max = [2.0, 1.5] }, material = "m" }]
@@ -222,21 +215,8 @@ supports = [
 ]
 loads = [{ kind = "displacement", name = "footing", box = { min = [0.0, 1.5], max = [0.5, 1.5] }, displacement = { y = -0.02 } }]
 "#,
+        Material::von_mises(1e4, 0.49, 3f64.sqrt()),
     )
-    .unwrap();
-    let s = scene::Scene {
-        dimension: 2,
-        grid: p.grid,
-        materials: [("m".to_string(), Material::von_mises(1e4, 0.49, 3f64.sqrt()))]
-            .into_iter()
-            .collect(),
-        bodies: p.bodies,
-        supports: p.supports,
-        loads: p.loads,
-        measures: vec![],
-    };
-    s.validate().unwrap();
-    s
 }
 
 /// A friction model (`drucker-prager` or `mohr-coulomb`) with φ = 30°, dilatancy `psi` and

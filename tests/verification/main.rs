@@ -37,4 +37,5 @@ mod patch;
 mod plasticity;
 mod robustness;
 mod scene;
+mod scene_text;
 mod tangent;

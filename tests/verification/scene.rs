@@ -6,34 +6,10 @@ use igimp::basis::method::Method;
 use igimp::discretise::ghost::{GhostFaces, GhostSettings};
 use igimp::material::constitutive::Material;
 use igimp::problems::compaction::{solve as solve_compaction, CompactionSpec};
-use igimp::problems::scene::{self, Scene, SceneSettings};
+use igimp::problems::scene::{self, SceneSettings};
 use igimp::solver::newton::{NewtonSettings, ResidualNorm};
 
-/// A scene from its TOML sections (the study file's), with materials resolved.
-fn scene(dimension: usize, toml_text: &str, material: Material) -> Scene {
-    #[derive(serde::Deserialize)]
-    struct Parts {
-        grid: scene::GridSection,
-        bodies: Vec<scene::Body>,
-        #[serde(default)]
-        supports: Vec<scene::Support>,
-        loads: Vec<scene::Load>,
-        #[serde(default)]
-        measures: Vec<scene::Measure>,
-    }
-    let p: Parts = toml::from_str(toml_text).unwrap();
-    let s = Scene {
-        dimension,
-        grid: p.grid,
-        materials: [("m".to_string(), material)].into_iter().collect(),
-        bodies: p.bodies,
-        supports: p.supports,
-        loads: p.loads,
-        measures: p.measures,
-    };
-    s.validate().unwrap();
-    s
-}
+use crate::scene_text::scene;
 
 /// The settings of the small scene tests: h = 1/2, 2 points per cell, `load_steps`, `newton`,
 /// a ghost penalty of `gamma` on cut cells.

@@ -44,9 +44,9 @@ pub(super) fn project_residual<const D: usize>(
         }
         let (mut w, mut wp) = (0.0, 0.0);
         for &q in patches.points(c) {
-            let t = trials[q].as_ref().expect("evaluated");
-            w += weight(&states[q]);
-            wp += weight(&states[q]) * t.response.tau.trace() / 3.0;
+            let (t, wq) = (trials[q].as_ref().expect("evaluated"), weight(&states[q]));
+            w += wq;
+            wp += wq * t.response.tau.trace() / 3.0;
         }
         let p_bar = wp / w;
         for &q in patches.points(c) {

@@ -198,10 +198,7 @@ impl ElementStudy {
                 })?;
         }
         if let Some(q) = &self.expect_quadratic {
-            for (k, v) in [("small", q.small), ("floor", q.floor), ("constant", q.constant)] {
-                chk.positive(&format!("expect_quadratic.{k}"), v)?;
-            }
-            chk.text("expect_quadratic.source", &q.source)?;
+            chk.quadratic("expect_quadratic", q)?;
         }
         Ok(())
     }

@@ -236,10 +236,7 @@ impl SceneStudy {
         for (i, e) in self.expect_quadratic.iter().enumerate() {
             let key = format!("expect_quadratic[{i}]");
             sweep(&format!("{key}.sweep"), &e.sweep)?;
-            for (k, v) in [("small", e.small), ("floor", e.floor), ("constant", e.constant)] {
-                chk.positive(&format!("{key}.{k}"), v)?;
-            }
-            chk.text(&format!("{key}.source"), &e.source)?;
+            chk.quadratic(&key, &e.terms())?;
         }
         Ok(())
     }
