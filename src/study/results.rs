@@ -61,6 +61,14 @@ pub struct StepRecord {
     /// [`crate::solver::newton::FLOOR_ACCEPT_FACTOR`] of it (absent: the tolerance was met).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub accepted_at_floor: Option<f64>,
+    /// Increments of the step that failed and were halved (0: none, or not recorded).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub cutbacks: usize,
+    /// Newton iterations of the step's increments before the one whose residuals are
+    /// recorded, failed and converged alike: the work `residuals` does not show (0 when the
+    /// nominal increment converged at once, or not recorded).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub earlier_iterations: usize,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -109,6 +117,14 @@ pub fn step_records(steps: &[StepReport]) -> Vec<StepRecord> {
             factor_nonzeros: s.linear.factor_nonzeros,
             linear_iterations: s.linear.iterations,
             accepted_at_floor: s.newton.accepted_floor,
+            cutbacks: s.cutbacks(),
+            // The last sub-step is the recorded increment itself.
+            earlier_iterations: s
+                .substeps
+                .iter()
+                .take(s.substeps.len().saturating_sub(1))
+                .map(|a| a.residuals.len().saturating_sub(1))
+                .sum(),
         })
         .collect()
 }

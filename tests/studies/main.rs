@@ -22,6 +22,7 @@ mod reliability;
 mod resume;
 mod scene_study;
 mod schema_doc;
+mod step_record;
 mod study;
 mod three_d_studies;
 mod trimmed;

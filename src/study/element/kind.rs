@@ -48,6 +48,8 @@ fn solve_test(study: &ElementStudy, t: &TestSection) -> ElementRecord {
             factor_nonzeros: 0,
             linear_iterations: 0,
             accepted_at_floor: None,
+            cutbacks: 0,
+            earlier_iterations: 0,
         })
         .collect();
     rec.solve = SolveRecord {

@@ -230,6 +230,8 @@ fn measure(scene: &Scene, case: &CaseFile, result: ResultFile, record: ExternalR
             factor_nonzeros: 0,
             linear_iterations: 0,
             accepted_at_floor: None,
+            cutbacks: 0,
+            earlier_iterations: 0,
         })
         .collect();
     let status = match result.status {

@@ -224,7 +224,19 @@ pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> Strin
             super::md_text(&sw.id),
             super::md_text(&sw.title)
         );
+        // Older records carry no cut-backs: the column shows only where some were recorded,
+        // so that their absence is not read as none (reference/README.md item 76).
+        let cut = |c: &crate::study::scene::SceneRecord| -> (usize, usize) {
+            c.solve
+                .steps
+                .iter()
+                .fold((0, 0), |(n, i), st| (n + st.cutbacks, i + st.earlier_iterations))
+        };
+        let show_cuts = cases.iter().any(|c| cut(c).0 > 0);
         s.push_str("| case | status | Newton |");
+        if show_cuts {
+            s.push_str(" cut-backs (their Newton) |");
+        }
         for m in &study.measures {
             let _ = write!(s, " {} |", m.name);
             if r.measures.references.contains_key(&m.name) {
@@ -232,6 +244,9 @@ pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> Strin
             }
         }
         s.push_str("\n|---|---|---:|");
+        if show_cuts {
+            s.push_str("---:|");
+        }
         for m in &study.measures {
             s.push_str("---:|");
             if r.measures.references.contains_key(&m.name) {
@@ -247,6 +262,10 @@ pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> Strin
                 c.solve.status.word(),
                 c.solve.newton_iterations
             );
+            if show_cuts {
+                let (n, i) = cut(c);
+                let _ = write!(s, " {n} ({i}) |");
+            }
             for m in &study.measures {
                 let v = c.measures.get(&m.name).copied();
                 let _ = write!(s, " {} |", v.map_or("—".into(), |v| format!("{v:.6e}")));
