@@ -119,6 +119,16 @@ impl StepReport {
     pub fn cutbacks(&self) -> usize {
         self.substeps.iter().filter(|s| !s.converged).count()
     }
+
+    /// Newton iterations of the increments before the one `newton` records, failed and
+    /// converged alike (the last sub-step is that increment itself).
+    pub fn earlier_iterations(&self) -> usize {
+        let earlier = self.substeps.len().saturating_sub(1);
+        self.substeps[..earlier]
+            .iter()
+            .map(|s| s.residuals.len().saturating_sub(1))
+            .sum()
+    }
 }
 
 /// The linear systems of one converged increment: unknowns and non-zeros of its tangent, the

@@ -118,13 +118,7 @@ pub fn step_records(steps: &[StepReport]) -> Vec<StepRecord> {
             linear_iterations: s.linear.iterations,
             accepted_at_floor: s.newton.accepted_floor,
             cutbacks: s.cutbacks(),
-            // The last sub-step is the recorded increment itself.
-            earlier_iterations: s
-                .substeps
-                .iter()
-                .take(s.substeps.len().saturating_sub(1))
-                .map(|a| a.residuals.len().saturating_sub(1))
-                .sum(),
+            earlier_iterations: s.earlier_iterations(),
         })
         .collect()
 }
