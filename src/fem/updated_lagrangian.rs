@@ -122,6 +122,9 @@ pub(crate) struct UlCore<const D: usize> {
     /// A body force b₀(X, t) and the Gauss points' reference positions X_q and volumes V_q0 it
     /// is applied at (b₀(X_q, t) V_q0 mapped with N_a: the consistent nodal force).
     pub body_force: Option<(BodyForce<D>, Vec<SVector<f64, D>>, Vec<f64>)>,
+    /// The ramp of the nodal forces (linear by default; a table from 1 at load factor 0 holds
+    /// them at full value from the first step, [`crate::material::prestress`]).
+    pub nodal_ramp: crate::solver::ramp::Ramp,
 }
 
 /// The nodes' velocity and acceleration (node·D + axis) and the time of the committed state of
@@ -150,6 +153,16 @@ impl<const D: usize> UlCore<D> {
             dynamics: None,
             motion: NodalState::default(),
             body_force: None,
+            nodal_ramp: Default::default(),
+        }
+    }
+
+    /// The nodal forces' factor at `load_factor` (a dynamic analysis's time function value,
+    /// not clamped to [0, 1], with the linear ramp).
+    fn nodal_factor(&self, load_factor: f64) -> f64 {
+        match &self.nodal_ramp {
+            crate::solver::ramp::Ramp::Linear => load_factor,
+            ramp => ramp.factor(load_factor),
         }
     }
 
@@ -221,11 +234,11 @@ impl<const D: usize> UlCore<D> {
             let t = self.motion.pending.map_or(load_factor, |t| t.end);
             b.add_to(x0, v0, t, &mut forces)?;
         }
-        let load_factor = factor;
+        let nodal_factor = self.nodal_factor(factor);
         let nodal: Vec<(usize, f64)> = loads
             .dof_forces
             .iter()
-            .map(|&(dof, force)| (dof, force * load_factor))
+            .map(|&(dof, force)| (dof, force * nodal_factor))
             .collect();
         // Generalised-α: the same loads at the step's start t₀.
         let start = match (self.dynamics, self.motion.pending) {
@@ -239,7 +252,7 @@ impl<const D: usize> UlCore<D> {
                 let nodal: Vec<(usize, f64)> = loads
                     .dof_forces
                     .iter()
-                    .map(|&(dof, force)| (dof, force * f0))
+                    .map(|&(dof, force)| (dof, force * self.nodal_factor(f0)))
                     .collect();
                 Some((forces, nodal))
             }

@@ -3,4 +3,5 @@
 
 pub mod constitutive;
 pub mod kinematics;
+pub mod prestress;
 pub mod tensor;

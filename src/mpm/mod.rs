@@ -60,6 +60,8 @@ pub struct MpmSolver<const D: usize> {
     body_force: Option<BodyForce<D>>,
     /// Prescribed nodal displacements ([`Self::prescribe`]).
     prescribed: crate::discretise::prescribed::PrescribedDisplacements,
+    /// The ramp of `loads.point_loads` ([`Self::set_point_load_ramp`]); linear by default.
+    point_load_ramp: crate::solver::ramp::Ramp,
 }
 
 /// The grid's motion at the start of a dynamic step, projected from the points, and the
@@ -143,6 +145,7 @@ impl<const D: usize> MpmSolver<D> {
             time: 0.0,
             body_force: None,
             prescribed: Default::default(),
+            point_load_ramp: Default::default(),
         })
     }
 
@@ -167,6 +170,13 @@ impl<const D: usize> MpmSolver<D> {
     /// quasi-static analysis).
     pub fn set_body_force(&mut self, body_force: BodyForce<D>) {
         self.body_force = Some(body_force);
+    }
+
+    /// Let the point loads follow `ramp` over the load steps instead of growing linearly: a
+    /// table from 1 at load factor 0 holds them at their full value from the first step
+    /// (the loads that balance an initial stress, [`crate::material::prestress`]).
+    pub fn set_point_load_ramp(&mut self, ramp: crate::solver::ramp::Ramp) {
+        self.point_load_ramp = ramp;
     }
 
     /// Prescribe the displacement of grid dofs (node, axis, value at full load), following
@@ -372,8 +382,13 @@ impl<const D: usize> MpmSolver<D> {
             .iter()
             .map(|&m| self.loads.gravity * (m * load_factor))
             .collect();
+        // A dynamic analysis's load factor is its time function's value, not clamped to [0, 1].
+        let factor = match &self.point_load_ramp {
+            crate::solver::ramp::Ramp::Linear => load_factor,
+            ramp => ramp.factor(load_factor),
+        };
         for (p, f) in &self.loads.point_loads {
-            forces[*p] += f * load_factor;
+            forces[*p] += f * factor;
         }
         forces
     }

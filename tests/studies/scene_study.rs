@@ -179,7 +179,7 @@ const MALFORMED: &[(&str, &str, &str, &str)] = &[
     ("samples on a displacement", "at = [2.0, 1.0]\n", "at = [2.0, 1.0]\nsamples = 3\n", "measures[1].samples"),
     ("traction on an unknown body", "kind = \"gravity\"\nvector = [0.0, -10.0]\nramp = { table = [[0.0, 0.0], [0.5, 0.8], [1.0, 1.0]] }", "kind = \"traction\"\nvector = [0.0, -10.0]\nbody = \"rock\"\nface = \"y+\"", "loads[0].body"),
     ("traction on an unknown face", "kind = \"gravity\"\nvector = [0.0, -10.0]\nramp = { table = [[0.0, 0.0], [0.5, 0.8], [1.0, 1.0]] }", "kind = \"traction\"\nvector = [0.0, -10.0]\nbody = \"block\"\nface = \"top\"", "loads[0].face"),
-    ("traction with a table ramp", "kind = \"gravity\"\nvector = [0.0, -10.0]\n", "kind = \"traction\"\nvector = [0.0, -10.0]\nbody = \"block\"\nface = \"y+\"\n", "loads[0].ramp"),
+    ("traction box off its face", "kind = \"gravity\"\nvector = [0.0, -10.0]\n", "kind = \"traction\"\nvector = [0.0, -10.0]\nbody = \"block\"\nface = \"y+\"\nbox = { min = [0.0, -5.0], max = [1.0, -4.0] }\n", "loads[0].box"),
     ("gravity with a face", "vector = [0.0, -10.0]\n", "vector = [0.0, -10.0]\nface = \"y+\"\n", "loads[0].face"),
     ("box and polygon", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }\npolygon = [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]]", "bodies[0]"),
     ("neither box nor polygon", "box = { min = [0.0, 0.0], max = [2.0, 1.0] }", "", "bodies[0]"),

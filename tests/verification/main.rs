@@ -35,6 +35,7 @@ mod mohr_coulomb;
 mod multigrid;
 mod patch;
 mod plasticity;
+mod prestress;
 mod robustness;
 mod scene;
 mod scene_text;

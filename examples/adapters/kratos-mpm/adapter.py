@@ -73,6 +73,8 @@ def unsupported(case):
         return f"model {model}: this adapter translates {', '.join(LAWS)}"
     if s.get("point_loads"):
         return "tractions and point loads: not translated"
+    if s.get("initial_stress"):
+        return "an initial stress: not translated"
     for k, (v, h) in enumerate(zip(s["points"]["volume"], s["points"]["half_length"])):
         box = 4.0 * h[0] * h[1]
         if abs(v - box) > 1e-12 * box:

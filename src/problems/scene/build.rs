@@ -4,7 +4,7 @@
 //! resolution before anything is built.
 
 use super::geometry::{bilinear, clip_square, mapped_cells};
-use super::spec::{axis_index, region, LoadKind, Region, Scene, SceneSettings, Shape};
+use super::spec::{axis_index, region, Bounds, LoadKind, Region, Scene, SceneSettings, Shape};
 use crate::basis::method::Method;
 use crate::fem::{ElementFamily, ElementMesh, HexElement, QuadElement};
 use crate::mesh::grid::Grid;
@@ -357,9 +357,38 @@ pub(super) fn region_dofs(
     Ok(out)
 }
 
-/// (axis, side, the face's coordinate, traction vector) of every traction of the scene, with
-/// the loaded body's index.
-fn tractions(scene: &Scene) -> Vec<(usize, usize, f64, f64, Vec<f64>)> {
+/// One traction: the loaded body's index, the face's axis, side and coordinate, the traction
+/// vector and the box that picks part of the face (none: all of it).
+struct FaceLoad<'a> {
+    body: usize,
+    axis: usize,
+    side: f64,
+    at: f64,
+    vector: Vec<f64>,
+    part: Option<&'a Bounds>,
+}
+
+impl FaceLoad<'_> {
+    /// The length of `[lo, hi]` along axis `a` that the loaded part of the face covers.
+    fn covered(&self, a: usize, lo: f64, hi: f64) -> f64 {
+        match self.part {
+            Some(b) => (hi.min(b.max[a]) - lo.max(b.min[a])).max(0.0),
+            None => hi - lo,
+        }
+    }
+}
+
+/// The ramp every traction of `scene` follows (validation makes it one): linear if none.
+pub(super) fn traction_ramp(scene: &Scene) -> Ramp {
+    scene
+        .loads
+        .iter()
+        .find(|l| l.kind == LoadKind::Traction)
+        .map_or(Ramp::Linear, |l| l.ramp.clone())
+}
+
+/// Every traction of the scene.
+fn tractions(scene: &Scene) -> Vec<FaceLoad<'_>> {
     scene
         .loads
         .iter()
@@ -372,36 +401,53 @@ fn tractions(scene: &Scene) -> Vec<(usize, usize, f64, f64, Vec<f64>)> {
             let (axis, side) = super::spec::face_of("", l.face.as_deref()?, scene.dimension).ok()?;
             let bx = scene.bodies[b].bounding_box();
             let at = if side > 0.0 { bx.max[axis] } else { bx.min[axis] };
-            Some((b, axis, side, at, l.vector.clone()?))
+            Some(FaceLoad {
+                body: b,
+                axis,
+                side,
+                at,
+                vector: l.vector.clone()?,
+                part: l.bounds.as_ref(),
+            })
         })
         .collect()
 }
 
 /// The tractions as point loads: every point of the loaded body whose domain reaches the
-/// face carries the traction times its domain's share of the face.
+/// face carries the traction times its domain's share of the face's loaded part.
 pub(super) fn traction_point_loads<const D: usize>(
     scene: &Scene,
     points: &MaterialPoints<D>,
     h: f64,
 ) -> Vec<(usize, SVector<f64, D>)> {
     let mut loads = vec![];
-    for (b, axis, side, at, t) in tractions(scene) {
-        let body = &scene.bodies[b];
+    for t in tractions(scene) {
+        let (body, axis) = (&scene.bodies[t.body], t.axis);
         for p in 0..points.len() {
             let (x, half) = (&points.position0[p], &points.half_length0[p]);
-            if !body.contains(x.as_slice(), 1e-9 * h) || (x[axis] + side * half[axis] - at).abs() > 1e-9 * h {
+            if !body.contains(x.as_slice(), 1e-9 * h)
+                || (x[axis] + t.side * half[axis] - t.at).abs() > 1e-9 * h
+            {
                 continue;
             }
-            let area: f64 = (0..D).filter(|&a| a != axis).map(|a| 2.0 * half[a]).product();
-            loads.push((p, SVector::<f64, D>::from_iterator(t.iter().map(|v| v * area))));
+            let area: f64 = (0..D)
+                .filter(|&a| a != axis)
+                .map(|a| t.covered(a, x[a] - half[a], x[a] + half[a]))
+                .product();
+            if area > 0.0 {
+                loads.push((
+                    p,
+                    SVector::<f64, D>::from_iterator(t.vector.iter().map(|v| v * area)),
+                ));
+            }
         }
     }
     loads
 }
 
 /// The tractions as consistent nodal forces: ∫ N_a t dA over the faces of the elements on the
-/// loaded face (a 3-point Gauss rule per face axis: exact for the faces of Q4/Q8 and
-/// Hex8/Hex20 of a box).
+/// loaded face, each face clipped to the loaded part (a 3-point Gauss rule per face axis over
+/// the clipped interval: exact for the straight faces of Q4/Q8 and Hex8/Hex20 of a box).
 pub(super) fn traction_nodal_forces<const D: usize, E: ElementFamily<D>>(
     scene: &Scene,
     mesh: &ElementMesh<D, E>,
@@ -410,8 +456,9 @@ pub(super) fn traction_nodal_forces<const D: usize, E: ElementFamily<D>>(
     let rule = crate::mesh::quadrature::GaussRule::try_new(3)?;
     let (xs, ws) = (rule.points(), rule.weights());
     let mut forces = vec![];
-    for (_, axis, side, at, t) in tractions(scene) {
-        let t = SVector::<f64, D>::from_iterator(t.iter().copied());
+    for load in tractions(scene) {
+        let (axis, side, at) = (load.axis, load.side, load.at);
+        let t = SVector::<f64, D>::from_iterator(load.vector.iter().copied());
         for e in 0..mesh.num_elements() {
             let ids = mesh.element_nodes(e);
             let on_face: Vec<usize> = (0..ids.len())
@@ -424,14 +471,28 @@ pub(super) fn traction_nodal_forces<const D: usize, E: ElementFamily<D>>(
                 continue;
             }
             let others: Vec<usize> = (0..D).filter(|&a| a != axis).collect();
+            // Per face axis, the loaded part of the face's ξ interval [−1, 1] as (centre, half).
+            let mut clip = [(0.0, 1.0); 3];
+            for &a in &others {
+                let span = on_face.iter().map(|&k| mesh.nodes[ids[k]][a]);
+                let lo = span.clone().fold(f64::INFINITY, f64::min);
+                let hi = span.fold(f64::NEG_INFINITY, f64::max);
+                let covered = load.covered(a, lo, hi);
+                let start = load.part.map_or(lo, |b| lo.max(b.min[a]));
+                let half = covered / (hi - lo);
+                clip[a] = (-1.0 + 2.0 * (start - lo) / (hi - lo) + half, half);
+            }
+            if others.iter().any(|&a| clip[a].1 <= 0.0) {
+                continue;
+            }
             let count = xs.len().pow(others.len() as u32);
             for q in 0..count {
                 let mut xi = SVector::<f64, D>::zeros();
                 xi[axis] = side;
                 let (mut r, mut w) = (q, 1.0);
                 for &a in &others {
-                    xi[a] = xs[r % xs.len()];
-                    w *= ws[r % xs.len()];
+                    xi[a] = clip[a].0 + clip[a].1 * xs[r % xs.len()];
+                    w *= ws[r % xs.len()] * clip[a].1;
                     r /= xs.len();
                 }
                 let (_, jac) = mesh.map(e, &xi);

@@ -6,6 +6,7 @@
 //! adapter: one path, so that the two agree.
 
 use super::build::{cells, fill_points, region_dofs, traction_point_loads, NamedDofs};
+use super::initial_stress::StressComponents;
 use super::spec::{LoadKind, Scene, SceneSettings};
 use crate::basis::Basis;
 use crate::material::constitutive::Material;
@@ -64,7 +65,8 @@ pub struct GravityLoad {
     pub ramp: Ramp,
 }
 
-/// A dead force on a material point (a traction's share), ramped linearly.
+/// A dead force on a material point (a traction's share), following the scene's
+/// `point_load_ramp`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PointLoad {
@@ -87,6 +89,16 @@ pub struct DiscreteScene {
     pub gravity: Vec<GravityLoad>,
     #[serde(default)]
     pub point_loads: Vec<PointLoad>,
+    /// The ramp every point load follows (default linear).
+    #[serde(default, skip_serializing_if = "is_linear")]
+    pub point_load_ramp: Ramp,
+    /// The Cauchy stress every point starts in (absent: unstressed), held elastically.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_stress: Option<StressComponents>,
+}
+
+fn is_linear(r: &Ramp) -> bool {
+    *r == Ramp::Linear
 }
 
 fn err(key: impl Into<String>, value: impl ToString, allowed: impl Into<String>) -> InputError {
@@ -144,6 +156,8 @@ impl DiscreteScene {
                     force: v(&f),
                 })
                 .collect(),
+            point_load_ramp: super::build::traction_ramp(scene),
+            initial_stress: body.initial_stress,
         })
     }
 
@@ -272,6 +286,10 @@ impl DiscreteScene {
             }
             vector(format!("point_loads[{i}].force"), &l.force)?;
         }
+        self.point_load_ramp.validate("point_load_ramp")?;
+        if let Some(t) = &self.initial_stress {
+            t.check("initial_stress", d)?;
+        }
         Ok(())
     }
 
@@ -353,6 +371,11 @@ impl DiscreteScene {
         };
         let fixed = super::build::fixed_dofs(&named);
         let mut solver = MpmSolver::try_new(grid, points, self.material.build()?, fixed, loads, settings)?;
+        solver.set_point_load_ramp(self.point_load_ramp.clone());
+        if let Some(t) = &self.initial_stress {
+            let model = self.material.build()?;
+            super::initial_stress::prestress("initial_stress", t, model.as_ref(), &mut solver.points.state)?;
+        }
         if let Some(b) = tabled {
             solver.set_body_force(b);
         }

@@ -8,6 +8,7 @@ mod closed_form;
 mod discrete;
 mod fields;
 pub mod geometry;
+pub mod initial_stress;
 mod measures;
 mod solve;
 mod spec;

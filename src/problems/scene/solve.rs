@@ -390,6 +390,12 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     };
     let mut fem = ContinuumFem::try_new(mesh, body.density, model, fixed, loads, settings)?;
     fem.set_pressure_projection(s.f_bar && s.pressure_projection);
+    fem.set_nodal_force_ramp(super::build::traction_ramp(scene));
+    if let Some(t) = &body.initial_stress {
+        let mut start = [crate::material::kinematics::PointState::undeformed(1.0)];
+        super::initial_stress::prestress("bodies[0].initial_stress", t, fem.model(), &mut start)?;
+        fem.start_every_point_in(&start[0]);
+    }
     if let Some(b) = tabled {
         fem.set_body_force(b);
     }

@@ -61,6 +61,10 @@ pub struct Body {
     /// Mass per unit initial volume (default 1).
     #[serde(default = "one")]
     pub density: f64,
+    /// The Cauchy stress the body starts in (absent: unstressed), held elastically; the
+    /// loads must balance it from the first step ([`super::initial_stress`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_stress: Option<super::initial_stress::StressComponents>,
 }
 
 fn one() -> f64 {
@@ -291,7 +295,7 @@ pub(super) fn vector(key: &str, v: &[f64], dimension: usize) -> Result<(), Input
 impl Bounds {
     /// `dimension` finite values each, max above min (`strict`, a body) or not below it (a
     /// region of nodes may be flat: a line or a plane of nodes).
-    fn check(&self, key: &str, dimension: usize, strict: bool) -> Result<(), InputError> {
+    pub(super) fn check(&self, key: &str, dimension: usize, strict: bool) -> Result<(), InputError> {
         vector(&format!("{key}.min"), &self.min, dimension)?;
         vector(&format!("{key}.max"), &self.max, dimension)?;
         for a in 0..dimension {
@@ -431,6 +435,19 @@ impl Scene {
                     format!(
                         "must be bodies[0]'s {:?}: the solvers hold one constitutive model for all points",
                         self.bodies[0].material
+                    ),
+                ));
+            }
+            if let Some(t) = &b.initial_stress {
+                t.check(&format!("{key}.initial_stress"), d)?;
+            }
+            if b.initial_stress != self.bodies[0].initial_stress {
+                return Err(err(
+                    format!("{key}.initial_stress"),
+                    format!("{:?}", b.initial_stress),
+                    format!(
+                        "must be bodies[0]'s {:?}: the solvers start every point in one state",
+                        self.bodies[0].initial_stress
                     ),
                 ));
             }

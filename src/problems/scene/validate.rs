@@ -34,13 +34,20 @@ impl Scene {
             LoadKind::Traction => {
                 refuse("name", l.name.is_some())?;
                 refuse("plane", l.plane.is_some())?;
-                refuse("box", l.bounds.is_some())?;
                 refuse("displacement", l.displacement.is_some())?;
-                if l.ramp != crate::solver::ramp::Ramp::Linear {
+                if let Some(b) = &l.bounds {
+                    b.check(&format!("{key}.box"), d, false)?;
+                }
+                // The solvers take one ramp for all point (nodal) loads.
+                let first = self.loads.iter().position(|o| o.kind == LoadKind::Traction);
+                if let Some(f) = first.filter(|&f| self.loads[f].ramp != l.ramp) {
                     return Err(err(
                         format!("{key}.ramp"),
-                        "a table",
-                        "must be \"linear\" for a traction (point and nodal loads grow with the load factor)",
+                        format!("{:?}", l.ramp),
+                        format!(
+                            "must be loads[{f}]'s {:?}: every traction follows one ramp",
+                            self.loads[f].ramp
+                        ),
                     ));
                 }
                 let v = l.vector.as_ref().ok_or_else(|| {
@@ -77,7 +84,31 @@ impl Scene {
                         "a traction needs a face, e.g. \"y+\"",
                     )
                 })?;
-                super::spec::face_of(&format!("{key}.face"), face, d).map(|_| ())
+                let (axis, side) = super::spec::face_of(&format!("{key}.face"), face, d)?;
+                if let Some(b) = &l.bounds {
+                    // The box picks part of the face: it must reach the face's plane and
+                    // overlap the face along every other axis.
+                    let bx = body.bounding_box();
+                    let at = if side > 0.0 { bx.max[axis] } else { bx.min[axis] };
+                    let meets = (0..d).all(|a| {
+                        if a == axis {
+                            b.min[a] <= at && at <= b.max[a]
+                        } else {
+                            b.min[a] < bx.max[a] && bx.min[a] < b.max[a]
+                        }
+                    });
+                    if !meets {
+                        return Err(err(
+                            format!("{key}.box"),
+                            format!("{:?} .. {:?}", b.min, b.max),
+                            format!(
+                                "must meet the face {face} of body {name:?} ({:?} .. {:?}) over a part of positive area",
+                                bx.min, bx.max
+                            ),
+                        ));
+                    }
+                }
+                Ok(())
             }
             LoadKind::Gravity => {
                 refuse("name", l.name.is_some())?;
