@@ -36,17 +36,42 @@ pub fn contract(a: &Tensor4, x: &Matrix3<f64>) -> Matrix3<f64> {
     unflatten(&(a * flatten(x)))
 }
 
+/// The entries of [`identity_sym`] (`sym`) or [`identity_outer`], column by column, formed
+/// at compile time: the constitutive tangents ask for them at every point and Newton
+/// iteration, where forming them took a tenth of an F-bar tangent (reference/README.md
+/// item 78).
+const fn identity_columns(sym: bool) -> [[f64; 9]; 9] {
+    let mut out = [[0.0; 9]; 9];
+    let mut c = 0;
+    while c < 9 {
+        let mut r = 0;
+        while r < 9 {
+            let (i, j, k, l) = (r / 3, r % 3, c / 3, c % 3);
+            out[c][r] = if sym {
+                0.5 * ((((i == k) && (j == l)) as u8 + ((i == l) && (j == k)) as u8) as f64)
+            } else {
+                ((i == j) && (k == l)) as u8 as f64
+            };
+            r += 1;
+        }
+        c += 1;
+    }
+    out
+}
+
+const IDENTITY_SYM: Tensor4 = Tensor4::from_array_storage(nalgebra::ArrayStorage(identity_columns(true)));
+const IDENTITY_OUTER: Tensor4 = Tensor4::from_array_storage(nalgebra::ArrayStorage(identity_columns(false)));
+
 /// Symmetric fourth-order identity `½(δ_ik δ_jl + δ_il δ_jk)`.
+#[inline]
 pub fn identity_sym() -> Tensor4 {
-    Tensor4::from_fn(|r, c| {
-        let (i, j, k, l) = (r / 3, r % 3, c / 3, c % 3);
-        0.5 * (((i == k) && (j == l)) as u8 as f64 + ((i == l) && (j == k)) as u8 as f64)
-    })
+    IDENTITY_SYM
 }
 
 /// `δ_ij δ_kl`.
+#[inline]
 pub fn identity_outer() -> Tensor4 {
-    Tensor4::from_fn(|r, c| ((r / 3 == r % 3) && (c / 3 == c % 3)) as u8 as f64)
+    IDENTITY_OUTER
 }
 
 /// Outer product `A_ij B_kl`.
@@ -61,4 +86,21 @@ pub fn pad3<const D: usize>(v: &nalgebra::SVector<f64, D>) -> [f64; 3] {
         out[a] = v[a];
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The compile-time identities are the formulas' entries.
+    #[test]
+    fn the_identities_are_their_formulas() {
+        let sym = Tensor4::from_fn(|r, c| {
+            let (i, j, k, l) = (r / 3, r % 3, c / 3, c % 3);
+            0.5 * (((i == k) && (j == l)) as u8 as f64 + ((i == l) && (j == k)) as u8 as f64)
+        });
+        let outer = Tensor4::from_fn(|r, c| ((r / 3 == r % 3) && (c / 3 == c % 3)) as u8 as f64);
+        assert_eq!(identity_sym(), sym);
+        assert_eq!(identity_outer(), outer);
+    }
 }

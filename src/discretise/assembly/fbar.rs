@@ -14,8 +14,8 @@ use super::local::{row_stretches, spatial_gradients, RowStretch};
 use crate::discretise::dofs::{DofMap, SupportTable, MAX_POINT_NODES};
 use crate::discretise::patches::VolumePatches;
 use crate::material::constitutive::ConstitutiveModel;
-use crate::material::kinematics::{PointState, PointTrial};
-use crate::material::tensor::ij;
+use crate::material::kinematics::{spatial_tangent_eigen, PointState, PointTrial};
+use crate::material::tensor::{ij, Tensor4};
 use crate::solver::sparse::ColumnBlock;
 use nalgebra::{Matrix3, SMatrix, SVector};
 use rayon::prelude::*;
@@ -36,6 +36,10 @@ pub struct FBarScratch {
     pub project_pressure: bool,
     /// With the projection, each point's trace tangent T (in-plane block) at the last tangent.
     trace: Vec<Matrix3<f64>>,
+    /// Each point's spatial tangent with its F-bar (and projection) terms, its in-plane
+    /// D⁴ entries (i, j, k, l < D) in a stride of D⁴: formed with q from one D^alg per point,
+    /// where the point kernel formed D^alg a second time (reference/README.md item 78).
+    tangents: Vec<f64>,
     /// The step's patch layout: what a patch block's rows and columns are, fixed within a
     /// step (the supports and equations are), so formed once per step, not per thread and
     /// iteration.
@@ -186,7 +190,8 @@ impl<'a> FBar<'a> {
         self.scratch.scale[p]
     }
 
-    /// Every point's q at the trial states of the last evaluation.
+    /// Every point's q (with the projection also its trace tangent) and its spatial tangent
+    /// with the F-bar terms, at the trial states of the last evaluation: one D^alg per point.
     pub(super) fn form_q<const D: usize>(
         &mut self,
         model: &dyn ConstitutiveModel,
@@ -194,18 +199,48 @@ impl<'a> FBar<'a> {
         trials: &[Option<PointTrial<D>>],
     ) {
         let project = self.scratch.project_pressure;
-        let q = &mut self.scratch.q;
-        q.resize(states.len(), Matrix3::zeros());
-        let trace = &mut self.scratch.trace;
-        trace.resize(if project { states.len() } else { 0 }, Matrix3::zeros());
-        if project {
-            super::pressure::form_trace::<D>(model, states, trials, q, trace);
-            return;
-        }
-        q.par_iter_mut().enumerate().for_each(|(p, qp)| {
-            let t = trials[p].as_ref().expect("evaluated");
-            *qp = super::local::point_q::<D>(model, &states[p], t, false).0;
-        });
+        let n = states.len();
+        let stride = D * D * D * D;
+        let scratch = &mut *self.scratch;
+        scratch.q.resize(n, Matrix3::zeros());
+        scratch.trace.resize(n, Matrix3::zeros());
+        scratch.tangents.resize(n * stride, 0.0);
+        let patches = self.patches;
+        scratch
+            .q
+            .par_iter_mut()
+            .zip(scratch.trace.par_iter_mut())
+            .zip(scratch.tangents.par_chunks_mut(stride))
+            .enumerate()
+            .for_each(|(p, ((qp, tp), out))| {
+                let t = trials[p].as_ref().expect("evaluated");
+                let (q, d_alg) = super::local::point_q::<D>(model, &states[p], t, project);
+                *qp = q;
+                if project {
+                    *tp = super::pressure::trace_tangent::<D>(&d_alg, t, &q);
+                }
+                let mut a = spatial_tangent_eigen::<D>(
+                    &d_alg,
+                    &t.b_trial_eigenvalues,
+                    &t.b_trial_eigenvectors,
+                    &t.sigma(),
+                    t.j,
+                );
+                if patches.is_shared(patches.of(p)) && fbar_terms() {
+                    adjust_tangent::<D>(&q, project.then_some(&*tp), &mut a);
+                }
+                let mut e = 0;
+                for i in 0..D {
+                    for j in 0..D {
+                        for k in 0..D {
+                            for l in 0..D {
+                                out[e] = a[(ij(i, j), ij(k, l))];
+                                e += 1;
+                            }
+                        }
+                    }
+                }
+            });
     }
 
     /// The views the point kernel and the patch blocks read.
@@ -214,6 +249,7 @@ impl<'a> FBar<'a> {
             patches: self.patches,
             dj: &self.scratch.dj,
             q: &self.scratch.q,
+            tangents: &self.scratch.tangents,
             layout: &self.scratch.layout,
             trace: self.scratch.project_pressure.then_some(&self.scratch.trace[..]),
         }
@@ -237,6 +273,7 @@ pub(super) struct FBarView<'a> {
     pub patches: &'a VolumePatches,
     dj: &'a [f64],
     q: &'a [Matrix3<f64>],
+    tangents: &'a [f64],
     layout: &'a PatchLayout,
     /// The trace tangents, with the pressure projection on.
     trace: Option<&'a [Matrix3<f64>]>,
@@ -247,33 +284,42 @@ pub(super) struct FBarView<'a> {
 const MAX_PATCH_NODES: usize = 7 * 7 * 7;
 
 impl FBarView<'_> {
-    /// Whether point `p` shares its patch (a patch of one point is plain).
-    #[inline]
-    pub fn shared(&self, p: usize) -> bool {
-        self.patches.is_shared(self.patches.of(p))
-    }
-
-    /// Subtract q_ij δ_kl from point `p`'s spatial tangent (the −q ⊗ I part).
-    pub fn adjust_point_tangent<const D: usize>(&self, p: usize, a: &mut SMatrix<f64, 9, 9>) {
-        if !self.shared(p) || !fbar_terms() {
-            return;
-        }
-        let q = &self.q[p];
+    /// Point `p`'s spatial tangent with its F-bar terms, as [`FBar::form_q`] formed it.
+    pub fn point_tangent<const D: usize>(&self, p: usize) -> Tensor4 {
+        let stride = D * D * D * D;
+        let stored = &self.tangents[p * stride..(p + 1) * stride];
+        let mut a = Tensor4::zeros();
+        let mut e = 0;
         for i in 0..D {
             for j in 0..D {
                 for k in 0..D {
-                    a[(ij(i, j), ij(k, k))] -= q[(i, j)];
+                    for l in 0..D {
+                        a[(ij(i, j), ij(k, l))] = stored[e];
+                        e += 1;
+                    }
                 }
             }
         }
-        if let Some(trace) = self.trace {
-            // The projection keeps the point's deviatoric rate only: −δ_ij T_kl / 3.
-            let t = &trace[p];
-            for i in 0..D {
-                for k in 0..D {
-                    for l in 0..D {
-                        a[(ij(i, i), ij(k, l))] -= t[(k, l)] / 3.0;
-                    }
+        a
+    }
+}
+
+/// Subtract q_ij δ_kl from a point's spatial tangent `a` (the −q ⊗ I part) and, with the
+/// pressure projection (its trace tangent `trace`), δ_ij T_kl / 3: the point keeps its
+/// deviatoric rate only.
+fn adjust_tangent<const D: usize>(q: &Matrix3<f64>, trace: Option<&Matrix3<f64>>, a: &mut Tensor4) {
+    for i in 0..D {
+        for j in 0..D {
+            for k in 0..D {
+                a[(ij(i, j), ij(k, k))] -= q[(i, j)];
+            }
+        }
+    }
+    if let Some(t) = trace {
+        for i in 0..D {
+            for k in 0..D {
+                for l in 0..D {
+                    a[(ij(i, i), ij(k, l))] -= t[(k, l)] / 3.0;
                 }
             }
         }

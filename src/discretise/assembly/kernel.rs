@@ -132,10 +132,10 @@ impl<const D: usize> PointKernel<'_, D> {
         let m = spatial_gradients(self.table, p, t, &mut gx);
         let md = m * D;
         kl.resize(md * md, 0.0);
-        let mut a = t.spatial_tangent(self.model, &self.states[p]);
-        if let Some(f) = &self.f_bar {
-            f.adjust_point_tangent::<D>(p, &mut a);
-        }
+        let a = match &self.f_bar {
+            Some(f) => f.point_tangent::<D>(p),
+            None => t.spatial_tangent(self.model, &self.states[p]),
+        };
         // The inertia term's α m_p S_a S_b δ_ik (consistent mass).
         let mass = self
             .inertia

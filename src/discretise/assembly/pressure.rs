@@ -15,10 +15,8 @@
 use super::local::spatial_gradients;
 use crate::discretise::dofs::{SupportTable, MAX_POINT_NODES};
 use crate::discretise::patches::VolumePatches;
-use crate::material::constitutive::ConstitutiveModel;
 use crate::material::kinematics::{spatial_trace_tangent, PointState, PointTrial};
 use nalgebra::{Matrix3, SVector};
-use rayon::prelude::*;
 
 /// q less its trace over the three axes: dev q.
 #[inline]
@@ -59,28 +57,18 @@ pub(super) fn project_residual<const D: usize>(
     }
 }
 
-/// Every point's q (with its out-of-plane diagonal) and trace tangent T − tr q δ_kl.
-pub(super) fn form_trace<const D: usize>(
-    model: &dyn ConstitutiveModel,
-    states: &[PointState],
-    trials: &[Option<PointTrial<D>>],
-    q: &mut [Matrix3<f64>],
-    trace: &mut [Matrix3<f64>],
-) {
-    q.par_iter_mut()
-        .zip(trace.par_iter_mut())
-        .enumerate()
-        .for_each(|(p, (qp, tp))| {
-            let t = trials[p].as_ref().expect("evaluated");
-            let (qt, d_alg) = super::local::point_q::<D>(model, &states[p], t, true);
-            *qp = qt;
-            let mut tr =
-                spatial_trace_tangent::<D>(&d_alg, &t.b_trial_eigenvalues, &t.b_trial_eigenvectors, t.j);
-            for k in 0..D {
-                tr[(k, k)] -= qp.trace();
-            }
-            *tp = tr;
-        });
+/// A point's trace tangent T − tr q δ_kl from its D^alg `d_alg` and q (with its out-of-plane
+/// diagonal) at trial `t`.
+pub(super) fn trace_tangent<const D: usize>(
+    d_alg: &crate::material::tensor::Tensor4,
+    t: &PointTrial<D>,
+    q: &Matrix3<f64>,
+) -> Matrix3<f64> {
+    let mut tr = spatial_trace_tangent::<D>(d_alg, &t.b_trial_eigenvalues, &t.b_trial_eigenvectors, t.j);
+    for k in 0..D {
+        tr[(k, k)] -= q.trace();
+    }
+    tr
 }
 
 /// Patch `points`' R (into `r`) and P (into `p`) over `nodes`, with F-bar's Ḡ `g`.

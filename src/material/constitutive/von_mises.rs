@@ -60,6 +60,9 @@ pub struct VonMises {
     bulk: f64,
     shear: f64,
     d_elastic: Tensor4,
+    /// K 1 ⊗ 1 and I_dev, the plastic tangent's constant parts, formed once.
+    bulk_outer: Tensor4,
+    i_dev: Tensor4,
 }
 
 impl VonMises {
@@ -81,6 +84,8 @@ impl VonMises {
             bulk: lambda + 2.0 * mu / 3.0,
             shear: mu,
             d_elastic: *elastic.stiffness(),
+            bulk_outer: identity_outer() * (lambda + 2.0 * mu / 3.0),
+            i_dev: identity_sym() - identity_outer() * (1.0 / 3.0),
         })
     }
 
@@ -127,7 +132,7 @@ impl ConstitutiveModel for VonMises {
     }
 
     fn tangent(&self, eps_trial: &Matrix3<f64>, _committed: &MaterialState) -> Tensor4 {
-        let (k, g) = (self.bulk, self.shear);
+        let g = self.shear;
         let s_trial = deviator(eps_trial) * (2.0 * g);
         let norm_s = s_trial.norm();
         let rho_trial = (1.5f64).sqrt() * norm_s;
@@ -136,8 +141,7 @@ impl ConstitutiveModel for VonMises {
         }
         let ratio = self.yield_stress / rho_trial;
         let n = s_trial / norm_s;
-        let i_dev = identity_sym() - identity_outer() * (1.0 / 3.0);
-        identity_outer() * k + (i_dev - outer(&n, &n)) * (2.0 * g * ratio)
+        self.bulk_outer + (self.i_dev - outer(&n, &n)) * (2.0 * g * ratio)
     }
 
     fn young_modulus(&self) -> f64 {
