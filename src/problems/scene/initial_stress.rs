@@ -3,12 +3,16 @@
 //! first step (a traction ramped by a table that starts at its full value) the body starts
 //! in equilibrium: the surcharge beside a footing (reference/README.md item 77).
 
-use super::spec::err;
 use crate::material::constitutive::ConstitutiveModel;
 use crate::material::kinematics::PointState;
 use crate::solver::error::InputError;
 use nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
+
+/// The error of `key` (not the scene spec's: that module uses this one).
+fn err(key: impl Into<String>, value: impl ToString, allowed: impl Into<String>) -> InputError {
+    InputError::new(key, value, allowed)
+}
 
 /// Components of a symmetric stress (tension positive); absent ones are zero.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
