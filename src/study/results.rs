@@ -38,7 +38,7 @@ impl CaseStatus {
 }
 
 /// Newton residual history of one converged load step.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct StepRecord {
     pub step: usize,
     pub load_factor: f64,
@@ -69,6 +69,19 @@ pub struct StepRecord {
     /// nominal increment converged at once, or not recorded).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub earlier_iterations: usize,
+}
+
+impl StepRecord {
+    /// A step of which only its residuals are known (an element test's, another code's):
+    /// the solver's counts are zero, "not recorded".
+    pub fn residuals_only(step: usize, load_factor: f64, residuals: Vec<f64>) -> Self {
+        Self {
+            step,
+            load_factor,
+            residuals,
+            ..Default::default()
+        }
+    }
 }
 
 fn is_zero(n: &usize) -> bool {

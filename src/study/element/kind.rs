@@ -39,18 +39,7 @@ fn solve_test(study: &ElementStudy, t: &TestSection) -> ElementRecord {
         .residuals
         .iter()
         .enumerate()
-        .map(|(k, r)| StepRecord {
-            step: k + 1,
-            load_factor: (k + 1) as f64 / total.max(1) as f64,
-            residuals: r.clone(),
-            unknowns: 0,
-            nonzeros: 0,
-            factor_nonzeros: 0,
-            linear_iterations: 0,
-            accepted_at_floor: None,
-            cutbacks: 0,
-            earlier_iterations: 0,
-        })
+        .map(|(k, r)| StepRecord::residuals_only(k + 1, (k + 1) as f64 / total.max(1) as f64, r.clone()))
         .collect();
     rec.solve = SolveRecord {
         status: if out.failure.is_some() {

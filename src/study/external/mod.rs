@@ -221,18 +221,7 @@ fn measure(scene: &Scene, case: &CaseFile, result: ResultFile, record: ExternalR
     let steps: Vec<StepRecord> = result
         .steps
         .iter()
-        .map(|s| StepRecord {
-            step: s.step,
-            load_factor: s.load_factor,
-            residuals: s.residuals.clone(),
-            unknowns: 0,
-            nonzeros: 0,
-            factor_nonzeros: 0,
-            linear_iterations: 0,
-            accepted_at_floor: None,
-            cutbacks: 0,
-            earlier_iterations: 0,
-        })
+        .map(|s| StepRecord::residuals_only(s.step, s.load_factor, s.residuals.clone()))
         .collect();
     let status = match result.status {
         RunStatus::Converged => CaseStatus::Converged,
