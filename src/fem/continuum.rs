@@ -263,17 +263,6 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
         self.core.nodal_ramp = ramp;
     }
 
-    /// Start every Gauss point in the state `state` (its volume kept): a prestressed body
-    /// ([`crate::material::prestress`]).
-    pub fn start_every_point_in(&mut self, state: &crate::material::kinematics::PointState) {
-        for s in &mut self.gauss.state {
-            *s = crate::material::kinematics::PointState {
-                volume: s.volume,
-                ..*state
-            };
-        }
-    }
-
     /// Load the Gauss points with a body force per unit reference volume b₀(X, t) besides
     /// `loads`: b₀(X_q, t) V_q0 at each Gauss point, mapped with N_a (the consistent nodal
     /// force of the element's quadrature), t the end time of each step (the load factor in a

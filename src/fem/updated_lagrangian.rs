@@ -157,15 +157,6 @@ impl<const D: usize> UlCore<D> {
         }
     }
 
-    /// The nodal forces' factor at `load_factor` (a dynamic analysis's time function value,
-    /// not clamped to [0, 1], with the linear ramp).
-    fn nodal_factor(&self, load_factor: f64) -> f64 {
-        match &self.nodal_ramp {
-            crate::solver::ramp::Ramp::Linear => load_factor,
-            ramp => ramp.factor(load_factor),
-        }
-    }
-
     /// Make the analysis dynamic from the nodal velocities `velocity` and accelerations
     /// `acceleration` (node·D + axis; `None`: zero; the fixed dofs' taken as zero) at time 0.
     pub fn start_dynamics(&mut self, newmark: Newmark, velocity: Vec<f64>, acceleration: Option<Vec<f64>>) {
@@ -234,7 +225,7 @@ impl<const D: usize> UlCore<D> {
             let t = self.motion.pending.map_or(load_factor, |t| t.end);
             b.add_to(x0, v0, t, &mut forces)?;
         }
-        let nodal_factor = self.nodal_factor(factor);
+        let nodal_factor = self.nodal_ramp.applied(factor);
         let nodal: Vec<(usize, f64)> = loads
             .dof_forces
             .iter()
@@ -252,7 +243,7 @@ impl<const D: usize> UlCore<D> {
                 let nodal: Vec<(usize, f64)> = loads
                     .dof_forces
                     .iter()
-                    .map(|&(dof, force)| (dof, force * self.nodal_factor(f0)))
+                    .map(|&(dof, force)| (dof, force * self.nodal_ramp.applied(f0)))
                     .collect();
                 Some((forces, nodal))
             }

@@ -382,11 +382,7 @@ impl<const D: usize> MpmSolver<D> {
             .iter()
             .map(|&m| self.loads.gravity * (m * load_factor))
             .collect();
-        // A dynamic analysis's load factor is its time function's value, not clamped to [0, 1].
-        let factor = match &self.point_load_ramp {
-            crate::solver::ramp::Ramp::Linear => load_factor,
-            ramp => ramp.factor(load_factor),
-        };
+        let factor = self.point_load_ramp.applied(load_factor);
         for (p, f) in &self.loads.point_loads {
             forces[*p] += f * factor;
         }

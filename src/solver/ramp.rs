@@ -29,6 +29,16 @@ impl Ramp {
         }
     }
 
+    /// The factor of a dead load following this ramp at `load_factor`: a table's value, or
+    /// with the linear ramp `load_factor` itself, unclamped (a dynamic analysis passes its
+    /// time function's value, which may leave [0, 1]).
+    pub fn applied(&self, load_factor: f64) -> f64 {
+        match self {
+            Ramp::Linear => load_factor,
+            table => table.factor(load_factor),
+        }
+    }
+
     /// A table has at least two rows, starts at λ = 0, ends at λ = 1, increases strictly in
     /// λ and has finite factors; `field` names it in the error.
     pub fn validate(&self, field: &str) -> Result<(), InputError> {

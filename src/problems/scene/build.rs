@@ -399,8 +399,7 @@ fn tractions(scene: &Scene) -> Vec<FaceLoad<'_>> {
                 .iter()
                 .position(|b| Some(&b.name) == l.body.as_ref())?;
             let (axis, side) = super::spec::face_of("", l.face.as_deref()?, scene.dimension).ok()?;
-            let bx = scene.bodies[b].bounding_box();
-            let at = if side > 0.0 { bx.max[axis] } else { bx.min[axis] };
+            let at = scene.bodies[b].face_at(axis, side);
             Some(FaceLoad {
                 body: b,
                 axis,

@@ -370,12 +370,13 @@ impl DiscreteScene {
             point_loads: self.point_loads.iter().map(|l| (l.point, at(&l.force))).collect(),
         };
         let fixed = super::build::fixed_dofs(&named);
-        let mut solver = MpmSolver::try_new(grid, points, self.material.build()?, fixed, loads, settings)?;
-        solver.set_point_load_ramp(self.point_load_ramp.clone());
+        let model = self.material.build()?;
         if let Some(t) = &self.initial_stress {
-            let model = self.material.build()?;
-            super::initial_stress::prestress("initial_stress", t, model.as_ref(), &mut solver.points.state)?;
+            let start = super::initial_stress::start_state("initial_stress", t, model.as_ref())?;
+            super::initial_stress::start_in(&mut points.state, &start);
         }
+        let mut solver = MpmSolver::try_new(grid, points, model, fixed, loads, settings)?;
+        solver.set_point_load_ramp(self.point_load_ramp.clone());
         if let Some(b) = tabled {
             solver.set_body_force(b);
         }

@@ -68,22 +68,23 @@ impl StressComponents {
     }
 }
 
-/// Give every state of `states` the initial stress `stress` under `model`; `key` names it in
-/// the error (a stress the model cannot hold elastically).
-pub fn prestress(
+/// The state (of unit volume) holding the initial stress `stress` under `model`; `key` names
+/// it in the error (a stress the model cannot hold elastically).
+pub fn start_state(
     key: &str,
     stress: &StressComponents,
     model: &dyn ConstitutiveModel,
-    states: &mut [PointState],
-) -> Result<(), InputError> {
-    let sigma = stress.matrix();
-    let start = crate::material::prestress::prestressed(model, &sigma, 1.0)
-        .map_err(|e| err(key, format!("{stress:?}"), e.0))?;
+) -> Result<PointState, InputError> {
+    crate::material::prestress::prestressed(model, &stress.matrix(), 1.0)
+        .map_err(|e| err(key, format!("{stress:?}"), e.0))
+}
+
+/// Start every state of `states` in `start`, each keeping its volume.
+pub fn start_in(states: &mut [PointState], start: &PointState) {
     for s in states.iter_mut() {
         *s = PointState {
             volume: s.volume,
-            ..start
+            ..*start
         };
     }
-    Ok(())
 }

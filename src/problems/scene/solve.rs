@@ -388,14 +388,17 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
         gravity: g,
         nodal_forces: traction_nodal_forces(scene, &mesh, h)?,
     };
+    let start = body
+        .initial_stress
+        .as_ref()
+        .map(|t| super::initial_stress::start_state("bodies[0].initial_stress", t, model.as_ref()))
+        .transpose()?;
     let mut fem = ContinuumFem::try_new(mesh, body.density, model, fixed, loads, settings)?;
+    if let Some(start) = &start {
+        super::initial_stress::start_in(&mut fem.gauss.state, start);
+    }
     fem.set_pressure_projection(s.f_bar && s.pressure_projection);
     fem.set_nodal_force_ramp(super::build::traction_ramp(scene));
-    if let Some(t) = &body.initial_stress {
-        let mut start = [crate::material::kinematics::PointState::undeformed(1.0)];
-        super::initial_stress::prestress("bodies[0].initial_stress", t, fem.model(), &mut start)?;
-        fem.start_every_point_in(&start[0]);
-    }
     if let Some(b) = tabled {
         fem.set_body_force(b);
     }

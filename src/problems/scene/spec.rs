@@ -104,6 +104,16 @@ impl Body {
         }
     }
 
+    /// The coordinate along `axis` of the body's face on `side` (±1) of its bounding box.
+    pub fn face_at(&self, axis: usize, side: f64) -> f64 {
+        let b = self.bounding_box();
+        if side > 0.0 {
+            b.max[axis]
+        } else {
+            b.min[axis]
+        }
+    }
+
     /// Does the body hold `x` (within `tol`)?
     pub fn contains(&self, x: &[f64], tol: f64) -> bool {
         match self.shape() {

@@ -88,8 +88,7 @@ impl Scene {
                 if let Some(b) = &l.bounds {
                     // The box picks part of the face: it must reach the face's plane and
                     // overlap the face along every other axis.
-                    let bx = body.bounding_box();
-                    let at = if side > 0.0 { bx.max[axis] } else { bx.min[axis] };
+                    let (bx, at) = (body.bounding_box(), body.face_at(axis, side));
                     let meets = (0..d).all(|a| {
                         if a == axis {
                             b.min[a] <= at && at <= b.max[a]
