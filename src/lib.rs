@@ -146,6 +146,8 @@ pub mod seeded {
         /// The pressure projection's tangent without its patch block R Pᵀ: the rate of the
         /// cell's mean pressure left out.
         PressureProjectionWithoutItsBlock = 14,
+        /// The strength reduction dividing the cohesion alone: tan φ (and tan ψ) left as given.
+        StrengthReductionCohesionOnly = 15,
     }
 
     static ACTIVE: AtomicU8 = AtomicU8::new(0);

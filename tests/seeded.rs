@@ -18,6 +18,7 @@
 //! | dynamic tangent without its mass term M/(βΔt²) | Newton order on the vibrating bar (check_quadratic, order ≥ 1.8) |
 //! | Mohr–Coulomb's edge returned with one multiplier | \|f\| ≤ 1e-10 c₀ after returns from triaxial trial states |
 //! | modified Cam-Clay's tangent without the hardening of p_c | central differences of the update (1e-6) on the wet side |
+//! | strength reduction dividing c alone (tan φ kept) | the slope's Q8 factor of safety within its band of Bishop's 1.380 |
 
 /// The integration tests' shared checks (the finite-difference tangents), so that a seeded bug
 /// meets the very check it is seeded against.
@@ -225,13 +226,39 @@ fn column_bad_checks(family: Method) -> Vec<String> {
     study.compare.clear();
     study.paper.clear();
     study.figures.clear();
-    let run = run_in_memory(&study, "column.toml", Tier::Quick).unwrap();
-    run.results
-        .checks
+    failing_checks(
+        &run_in_memory(&study, "column.toml", Tier::Quick)
+            .unwrap()
+            .results
+            .checks,
+    )
+}
+
+/// The ids of the checks that did not pass (failed or not evaluated).
+fn failing_checks(checks: &[igimp::study::checks::CheckRecord]) -> Vec<String> {
+    checks
         .iter()
         .filter(|c| c.pass != Some(true))
         .map(|c| c.id.clone())
         .collect()
+}
+
+/// The failing checks of the slope study's quick tier cut to its coarse Q8 sweep and the
+/// checks on that sweep (Q8's factor of safety against Bishop's 1.380).
+fn slope_bad_checks() -> Vec<String> {
+    use igimp::study::scene::SceneStudy;
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies/slope-strength-reduction.toml");
+    let mut study = SceneStudy::load(&path).unwrap();
+    study.sweeps.retain(|x| x.id == "q8-coarse");
+    study.expect_reference.retain(|e| e.sweep == "q8-coarse");
+    study.expect_rate.retain(|e| e.sweep == "q8-coarse");
+    study.expect_quadratic.retain(|e| e.sweep == "q8-coarse");
+    assert!(
+        !study.expect_reference.is_empty(),
+        "no Q8 check in the slope study"
+    );
+    let run = run_in_memory(&study, "slope-strength-reduction.toml", Tier::Quick).unwrap();
+    failing_checks(&run.results.checks)
 }
 
 /// Newton's order on a large-amplitude vibrating bar (v₀/c = 0.05, iGIMP, consistent mass):
@@ -537,6 +564,19 @@ fn every_seeded_bug_is_caught() {
     assert!(
         wrong > 1e-6,
         "the projected tangent without its block passed: {wrong:e}"
+    );
+
+    // 16. The strength reduction dividing the cohesion alone: the slope's Q8 factor of
+    //     safety leaves its band around Bishop's 1.380 (studies/slope-strength-reduction.toml).
+    let right = slope_bad_checks();
+    set(Bug::StrengthReductionCohesionOnly);
+    let wrong = slope_bad_checks();
+    set(Bug::None);
+    eprintln!("strength reduction of c alone: failing checks {wrong:?} (correct {right:?})");
+    assert!(right.is_empty(), "the correct strength reduction fails {right:?}");
+    assert!(
+        !wrong.is_empty(),
+        "a strength reduction of c alone passed the slope's checks"
     );
 
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.

@@ -263,6 +263,15 @@ impl<const D: usize, E: ElementFamily<D>> ContinuumFem<D, E> {
         self.core.nodal_ramp = ramp;
     }
 
+    /// Divide the model's strength by the reduction's factor at each increment's load factor
+    /// (the model becomes the reduction's material, rebuilt before every increment).
+    pub fn set_strength_reduction(
+        &mut self,
+        reduction: Option<crate::material::strength_reduction::StrengthReduction>,
+    ) {
+        self.core.strength_reduction = reduction;
+    }
+
     /// Load the Gauss points with a body force per unit reference volume b₀(X, t) besides
     /// `loads`: b₀(X_q, t) V_q0 at each Gauss point, mapped with N_a (the consistent nodal
     /// force of the element's quadrature), t the end time of each step (the load factor in a
@@ -411,6 +420,9 @@ impl<const D: usize, E: ElementFamily<D>> LoadStepping for ContinuumFem<D, E> {
         // grids, which the deformed ones need not.
         if self.settings.linear_solver == LinearSolver::Iterative && self.core.work.node_geometry.is_none() {
             self.core.work.node_geometry = Some(crate::solver::multigrid::NodeGeometry::of_mesh(&self.mesh0));
+        }
+        if let Some(r) = &self.core.strength_reduction {
+            self.core.model = r.model_at(load_factor);
         }
         self.sync_f_bar();
         fem_advance(

@@ -125,6 +125,8 @@ pub(crate) struct UlCore<const D: usize> {
     /// The ramp of the nodal forces (linear by default; a table from 1 at load factor 0 holds
     /// them at full value from the first step, [`crate::material::prestress`]).
     pub nodal_ramp: crate::solver::ramp::Ramp,
+    /// The strength reduction `model` follows: rebuilt before every increment (none: fixed).
+    pub strength_reduction: Option<crate::material::strength_reduction::StrengthReduction>,
 }
 
 /// The nodes' velocity and acceleration (node·D + axis) and the time of the committed state of
@@ -154,6 +156,7 @@ impl<const D: usize> UlCore<D> {
             motion: NodalState::default(),
             body_force: None,
             nodal_ramp: Default::default(),
+            strength_reduction: None,
         }
     }
 

@@ -4,4 +4,5 @@
 pub mod constitutive;
 pub mod kinematics;
 pub mod prestress;
+pub mod strength_reduction;
 pub mod tensor;

@@ -62,6 +62,8 @@ pub struct MpmSolver<const D: usize> {
     prescribed: crate::discretise::prescribed::PrescribedDisplacements,
     /// The ramp of `loads.point_loads` ([`Self::set_point_load_ramp`]); linear by default.
     point_load_ramp: crate::solver::ramp::Ramp,
+    /// The strength reduction the model follows ([`Self::set_strength_reduction`]).
+    strength_reduction: Option<crate::material::strength_reduction::StrengthReduction>,
 }
 
 /// The grid's motion at the start of a dynamic step, projected from the points, and the
@@ -146,6 +148,7 @@ impl<const D: usize> MpmSolver<D> {
             body_force: None,
             prescribed: Default::default(),
             point_load_ramp: Default::default(),
+            strength_reduction: None,
         })
     }
 
@@ -177,6 +180,15 @@ impl<const D: usize> MpmSolver<D> {
     /// (the loads that balance an initial stress, [`crate::material::prestress`]).
     pub fn set_point_load_ramp(&mut self, ramp: crate::solver::ramp::Ramp) {
         self.point_load_ramp = ramp;
+    }
+
+    /// Divide the model's strength by the reduction's factor at each increment's load factor
+    /// (the model becomes the reduction's material, rebuilt before every increment).
+    pub fn set_strength_reduction(
+        &mut self,
+        reduction: Option<crate::material::strength_reduction::StrengthReduction>,
+    ) {
+        self.strength_reduction = reduction;
     }
 
     /// Prescribe the displacement of grid dofs (node, axis, value at full load), following

@@ -134,6 +134,9 @@ impl<const D: usize> MpmSolver<D> {
 
 impl<const D: usize> LoadStepping for MpmSolver<D> {
     fn advance(&mut self, load_factor: f64) -> Result<Increment, FailedAttempt> {
+        if let Some(r) = &self.strength_reduction {
+            self.model = r.model_at(load_factor);
+        }
         let step = self.prepare_step(load_factor).map_err(FailedAttempt::from)?;
         if self.settings.linear_solver == crate::solver::linear::LinearSolver::Iterative
             && self.work.node_geometry.is_none()

@@ -200,6 +200,9 @@ pub struct SolveError {
     pub attempts: usize,
     /// Load factor the failing attempt aimed at.
     pub load_factor: f64,
+    /// Load factor of the last committed state, which the solver holds after the failure
+    /// (a converged sub-step of the failing step counts).
+    pub reached: f64,
 }
 
 fn cut_note(attempts: usize, load_factor: f64) -> String {

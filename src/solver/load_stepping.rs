@@ -233,6 +233,7 @@ pub trait LoadStepping {
                             residuals,
                             attempts: substeps.len() + 1,
                             load_factor: to,
+                            reached: current,
                         });
                     }
                     substeps.push(SubStep {

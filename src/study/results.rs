@@ -25,6 +25,10 @@ pub enum CaseStatus {
     Failed,
     /// The solver refused the input (see `failure.reason`); nothing was solved.
     Rejected,
+    /// A strength reduction drove the body to collapse: the step where it collapsed is in
+    /// `failure`, and the measures (the factor of safety among them) are those of the last
+    /// converged state.
+    Collapsed,
 }
 
 impl CaseStatus {
@@ -33,7 +37,14 @@ impl CaseStatus {
             CaseStatus::Converged => "converged",
             CaseStatus::Failed => "failed",
             CaseStatus::Rejected => "rejected",
+            CaseStatus::Collapsed => "collapsed",
         }
+    }
+
+    /// Did the case give its measures: did it converge, or end in the collapse it was
+    /// driven to?
+    pub fn solved(self) -> bool {
+        matches!(self, CaseStatus::Converged | CaseStatus::Collapsed)
     }
 }
 
@@ -440,7 +451,7 @@ impl Failures {
                 .or_else(|| c.pointer("/solve/status"))
                 .and_then(|v| serde_json::from_value::<CaseStatus>(v.clone()).ok());
             match status {
-                Some(CaseStatus::Converged) => {}
+                Some(CaseStatus::Converged | CaseStatus::Collapsed) => {}
                 Some(s) => match super::vocabulary::expected_reason(&declared, &id) {
                     Some(reason) => out.expected.push((id, reason.to_string())),
                     None => out.unexpected.push((id, s)),

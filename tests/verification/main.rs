@@ -39,4 +39,5 @@ mod prestress;
 mod robustness;
 mod scene;
 mod scene_text;
+mod strength_reduction;
 mod tangent;

@@ -271,6 +271,7 @@ loads = [{loads}]
             supports: p.supports,
             loads: p.loads,
             measures: vec![],
+            strength_reduction: None,
         }
     };
     let cases = [

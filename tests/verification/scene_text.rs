@@ -26,6 +26,7 @@ pub fn scene(dimension: usize, toml_text: &str, material: Material) -> Scene {
         supports: p.supports,
         loads: p.loads,
         measures: p.measures,
+        strength_reduction: None,
     };
     s.validate().unwrap();
     s

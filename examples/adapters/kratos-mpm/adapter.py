@@ -75,6 +75,8 @@ def unsupported(case):
         return "tractions and point loads: not translated"
     if s.get("initial_stress"):
         return "an initial stress: not translated"
+    if s.get("strength_reduction"):
+        return "a strength reduction: not translated"
     for k, (v, h) in enumerate(zip(s["points"]["volume"], s["points"]["half_length"])):
         box = 4.0 * h[0] * h[1]
         if abs(v - box) > 1e-12 * box:

@@ -95,6 +95,10 @@ pub struct DiscreteScene {
     /// The Cauchy stress every point starts in (absent: unstressed), held elastically.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_stress: Option<StressComponents>,
+    /// The factor the material's strength is divided by, over the load steps (absent: none;
+    /// [`crate::material::strength_reduction`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub strength_reduction: Option<Ramp>,
 }
 
 fn is_linear(r: &Ramp) -> bool {
@@ -158,6 +162,7 @@ impl DiscreteScene {
                 .collect(),
             point_load_ramp: super::build::traction_ramp(scene),
             initial_stress: body.initial_stress,
+            strength_reduction: scene.strength_reduction.as_ref().map(|r| r.ramp.clone()),
         })
     }
 
@@ -377,6 +382,13 @@ impl DiscreteScene {
         }
         let mut solver = MpmSolver::try_new(grid, points, model, fixed, loads, settings)?;
         solver.set_point_load_ramp(self.point_load_ramp.clone());
+        if let Some(r) = &self.strength_reduction {
+            solver.set_strength_reduction(Some(crate::material::strength_reduction::StrengthReduction::new(
+                "strength_reduction",
+                self.material,
+                r.clone(),
+            )?));
+        }
         if let Some(b) = tabled {
             solver.set_body_force(b);
         }

@@ -27,6 +27,12 @@ pub enum MeasureKind {
     /// `at` to `to` in the current configuration, at `samples` points, each the stress of the
     /// nearest integration point: written per case as a profile; its value is their mean.
     StressLine,
+    /// The factor of safety: the strength reduction's factor F where the body fails (needs
+    /// `[strength_reduction]`). It fails where no load step converges any more (F at the
+    /// last converged state) or, with `at`, `component` and `limit`, where that displacement
+    /// has moved `limit` since the reduction began (F interpolated between the steps),
+    /// whichever comes first; absent if the body stood at every F.
+    FactorOfSafety,
 }
 
 /// A stress component `xx`, `yy`, `xy`, … (plane strain also `zz`) as (row, column).
@@ -67,6 +73,10 @@ pub struct Measure {
     pub scale: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference: Option<Reference>,
+    /// A factor of safety's displacement limit: the body has failed once the displacement
+    /// `component` at `at` has moved this far since the strength reduction began.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limit: Option<f64>,
 }
 
 /// A closed form a measure is compared with.

@@ -12,6 +12,7 @@ pub mod initial_stress;
 mod measures;
 mod solve;
 mod spec;
+mod strength;
 mod validate;
 
 pub use build::check_resolution;
@@ -21,5 +22,6 @@ pub use fields::{measures_of_fields, region_reactions, PointFields, Reactions};
 pub use solve::{methods, solve, MeasureValue, PointRecord, SceneOutcome};
 pub use spec::{
     axis_index, region, Body, Bounds, ClosedForm, Components, GridSection, Load, LoadKind, Measure,
-    MeasureKind, Plane, Reference, Region, Scene, SceneSettings, Shape, Support, AXES,
+    MeasureKind, Plane, Reference, Region, Scene, SceneSettings, Shape, StrengthReductionSection, Support,
+    AXES,
 };

@@ -43,6 +43,9 @@ pub struct PointRecord {
 pub struct SceneOutcome {
     pub steps: Vec<StepReport>,
     pub failure: Option<SolveError>,
+    /// Did the run end in the collapse its strength reduction drove it to
+    /// ([`Scene::collapsed`])? Then `failure` is where it collapsed.
+    pub collapsed: bool,
     /// The measures at the last converged step (in the scene's order), and their histories.
     pub measures: Vec<MeasureValue>,
     /// Material points or elements.
@@ -204,52 +207,73 @@ pub(super) fn read_measures(scene: &Scene, named: &NamedDofs, probe: &Probe<'_>)
                 .as_ref()
                 .and_then(|c| axis_index("", c, scene.dimension).ok())
                 .unwrap_or(0);
-            let reading = match m.kind {
-                MeasureKind::Displacement => value((probe.displacement)(
-                    m.at.as_deref().unwrap_or(&[]),
-                    axis,
-                    m.domain_edge,
-                )),
-                MeasureKind::Reaction if probe.region_reaction.is_some() => {
-                    let region = m.region.as_deref().unwrap_or("");
-                    value(
-                        probe
-                            .region_reaction
-                            .and_then(|r| r(region, axis))
-                            .unwrap_or(f64::NAN),
-                    )
-                }
-                MeasureKind::Reaction => {
-                    let dofs = named
-                        .iter()
-                        .find(|n| Some(&n.0) == m.region.as_ref())
-                        .map_or(&[][..], |n| &n.1[..]);
-                    value(
-                        dofs.iter()
-                            .filter(|d| d.1 == axis)
-                            .map(|&(n, a)| (probe.reaction)(n, a))
-                            .sum(),
-                    )
-                }
-                MeasureKind::StrainEnergy => {
-                    let (e, nu) = scene.hencky_parameters("").unwrap_or((f64::NAN, f64::NAN));
-                    let neo = scene.materials[&scene.bodies[0].material].model() == "neo-hookean";
-                    let mut sum = 0.0;
-                    (probe.points)(&mut |_, _, v0, state| sum += energy(state, v0, e, nu, neo));
-                    value(sum)
-                }
-                MeasureKind::ColumnStressError => value(column_stress_error(scene, probe.points)),
-                MeasureKind::StressLine => {
-                    let profile = stress_line(scene, m, probe.points);
-                    Reading {
-                        value: profile.iter().sum::<f64>() / profile.len().max(1) as f64,
-                        profile,
+            let reading =
+                match m.kind {
+                    MeasureKind::Displacement | MeasureKind::FactorOfSafety if m.at.is_some() => value(
+                        (probe.displacement)(m.at.as_deref().unwrap_or(&[]), axis, m.domain_edge),
+                    ),
+                    MeasureKind::Reaction if probe.region_reaction.is_some() => {
+                        let region = m.region.as_deref().unwrap_or("");
+                        value(
+                            probe
+                                .region_reaction
+                                .and_then(|r| r(region, axis))
+                                .unwrap_or(f64::NAN),
+                        )
                     }
-                }
-            };
+                    MeasureKind::Reaction => {
+                        let dofs = named
+                            .iter()
+                            .find(|n| Some(&n.0) == m.region.as_ref())
+                            .map_or(&[][..], |n| &n.1[..]);
+                        value(
+                            dofs.iter()
+                                .filter(|d| d.1 == axis)
+                                .map(|&(n, a)| (probe.reaction)(n, a))
+                                .sum(),
+                        )
+                    }
+                    MeasureKind::StrainEnergy => {
+                        let (e, nu) = scene.hencky_parameters("").unwrap_or((f64::NAN, f64::NAN));
+                        let neo = scene.materials[&scene.bodies[0].material].model() == "neo-hookean";
+                        let mut sum = 0.0;
+                        (probe.points)(&mut |_, _, v0, state| sum += energy(state, v0, e, nu, neo));
+                        value(sum)
+                    }
+                    MeasureKind::ColumnStressError => value(column_stress_error(scene, probe.points)),
+                    // Known only when the run ends ([`with_factor_of_safety`]); read meanwhile:
+                    // the displacement its limit watches, if it has one.
+                    MeasureKind::Displacement | MeasureKind::FactorOfSafety => value(f64::NAN),
+                    MeasureKind::StressLine => {
+                        let profile = stress_line(scene, m, probe.points);
+                        Reading {
+                            value: profile.iter().sum::<f64>() / profile.len().max(1) as f64,
+                            profile,
+                        }
+                    }
+                };
             scaled(m.scale, reading)
         })
         .collect()
+}
+
+/// `measures` with their factors of safety ([`Scene::factor_of_safety`]) from the run's
+/// `failure` and each one's readings after every step (`history`, of `load_steps` steps).
+fn with_factor_of_safety(
+    scene: &Scene,
+    mut measures: Vec<MeasureValue>,
+    history: &[Vec<Reading>],
+    load_steps: usize,
+    failure: Option<&SolveError>,
+) -> Vec<MeasureValue> {
+    for (k, (m, v)) in scene.measures.iter().zip(&mut measures).enumerate() {
+        if m.kind == MeasureKind::FactorOfSafety {
+            let moved: Vec<f64> = history.iter().map(|h| h[k].value).collect();
+            let limit = m.limit.map(|l| (l, &moved[..]));
+            v.value = scene.factor_of_safety(failure, limit, load_steps) * m.scale.unwrap_or(1.0);
+        }
+    }
+    measures
 }
 
 /// `reading` multiplied by `scale` (none: 1, the reading itself).
@@ -336,7 +360,13 @@ fn solve_mpm<const D: usize>(
     let mut history = vec![];
     let run = solver.run_observed(&mut |solver, _| history.push(measure(solver)));
     let (steps, failure) = steps_and_failure(run);
-    let measures = gather(scene, history, || measure(&solver));
+    let measures = with_factor_of_safety(
+        scene,
+        gather(scene, history.clone(), || measure(&solver)),
+        &history,
+        s.load_steps,
+        failure.as_ref(),
+    );
     let pts = &solver.points;
     let points = (0..pts.len())
         .map(|p| PointRecord {
@@ -348,6 +378,7 @@ fn solve_mpm<const D: usize>(
         })
         .collect();
     Ok(SceneOutcome {
+        collapsed: scene.collapsed(failure.as_ref()),
         steps,
         failure,
         measures,
@@ -399,6 +430,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     }
     fem.set_pressure_projection(s.f_bar && s.pressure_projection);
     fem.set_nodal_force_ramp(super::build::traction_ramp(scene));
+    fem.set_strength_reduction(scene.strength_reduction()?);
     if let Some(b) = tabled {
         fem.set_body_force(b);
     }
@@ -429,9 +461,16 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
     let run = fem.run_observed(&mut |fem, _| history.push(measure(fem)));
     let (steps, failure) = steps_and_failure(run);
     Ok(SceneOutcome {
+        collapsed: scene.collapsed(failure.as_ref()),
+        measures: with_factor_of_safety(
+            scene,
+            gather(scene, history.clone(), || measure(&fem)),
+            &history,
+            s.load_steps,
+            failure.as_ref(),
+        ),
         steps,
         failure,
-        measures: gather(scene, history, || measure(&fem)),
         size: fem.mesh.num_elements(),
         points: vec![],
     })

@@ -260,6 +260,15 @@ pub fn column_axis(scene: &Scene) -> Option<(usize, f64)> {
     (g[axis] < 0.0).then_some((axis, -g[axis]))
 }
 
+/// `[strength_reduction]`: the factor F by which the strength is divided, as a table of
+/// [load fraction, F] rows (`ramp = { table = [[0.0, 1.0], [0.2, 1.0], [1.0, 2.0]] }`: the
+/// full strength while gravity comes on over the first fifth, then F rising to 2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StrengthReductionSection {
+    pub ramp: Ramp,
+}
+
 /// A whole scene with its materials resolved.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Scene {
@@ -270,6 +279,11 @@ pub struct Scene {
     pub supports: Vec<Support>,
     pub loads: Vec<Load>,
     pub measures: Vec<Measure>,
+    /// The strength divided by a rising factor ([`super::strength`]); none: the strength
+    /// as given. Absent from the serialised scene when none, so that the cases of scenes
+    /// without one keep their keys.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub strength_reduction: Option<StrengthReductionSection>,
 }
 
 pub(super) fn err(key: impl Into<String>, value: impl ToString, allowed: impl Into<String>) -> InputError {
@@ -490,6 +504,7 @@ impl Scene {
         for (i, m) in self.measures.iter().enumerate() {
             self.check_measure(i, m, &mut measures)?;
         }
+        self.strength_reduction()?;
         Ok(())
     }
 

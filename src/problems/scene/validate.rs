@@ -192,6 +192,9 @@ impl Scene {
             refuse("to", m.to.is_some())?;
             refuse("samples", m.samples.is_some())?;
         }
+        if m.kind != MeasureKind::FactorOfSafety {
+            refuse("limit", m.limit.is_some())?;
+        }
         match m.kind {
             MeasureKind::Displacement => {
                 refuse("region", m.region.is_some())?;
@@ -289,6 +292,39 @@ impl Scene {
                         format!("{key}.kind"),
                         "column-stress-error",
                         "needs one box body and one gravity load along an axis, pointing to its negative side",
+                    ));
+                }
+            }
+            MeasureKind::FactorOfSafety => {
+                for (f, g) in [
+                    ("region", m.region.is_some()),
+                    ("domain_edge", m.domain_edge),
+                    ("history", m.history),
+                ] {
+                    refuse(f, g)?;
+                }
+                if let Some(limit) = m.limit {
+                    if !(limit.is_finite() && limit > 0.0) {
+                        return Err(err(format!("{key}.limit"), limit, "must be a displacement > 0"));
+                    }
+                    let at = m.at.as_ref().ok_or_else(|| {
+                        err(
+                            format!("{key}.at"),
+                            "missing",
+                            "a displacement limit needs the point it is read at",
+                        )
+                    })?;
+                    vector(&format!("{key}.at"), at, d)?;
+                    self.component(&key, m)?;
+                } else {
+                    refuse("at", m.at.is_some())?;
+                    refuse("component", m.component.is_some())?;
+                }
+                if self.strength_reduction.is_none() {
+                    return Err(err(
+                        format!("{key}.kind"),
+                        "factor-of-safety",
+                        "needs a [strength_reduction] section: the factor of safety is the factor at which the body collapses",
                     ));
                 }
             }

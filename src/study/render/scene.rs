@@ -6,7 +6,7 @@ use super::{checks_markdown, failures_markdown, IndexEntry};
 use crate::study::checks::check_counts;
 use crate::study::render::plot::{convergence_svg_along, ConvergenceSeries};
 use crate::study::render::plot2d::{xy_svg, LegendCorner, XyAxes, XySeries};
-use crate::study::results::{read_results, CaseStatus};
+use crate::study::results::read_results;
 use crate::study::scene::SceneResults;
 use crate::study::StudyError;
 use std::fmt::Write as _;
@@ -270,9 +270,7 @@ pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> Strin
                 let v = c.measures.get(&m.name).copied();
                 let _ = write!(s, " {} |", v.map_or("—".into(), |v| format!("{v:.6e}")));
                 if let Some(reference) = r.measures.references.get(&m.name) {
-                    let e = v
-                        .filter(|_| c.solve.status == CaseStatus::Converged)
-                        .map(|v| reference.error(v));
+                    let e = v.filter(|_| c.solve.status.solved()).map(|v| reference.error(v));
                     let _ = write!(s, " {} |", e3(e));
                 }
             }

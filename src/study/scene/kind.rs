@@ -70,6 +70,9 @@ fn solve_case(
             }
             Ok(o) => {
                 rec.solve = SolveRecord::of(&o.steps, o.failure.as_ref());
+                if o.collapsed {
+                    rec.solve.status = CaseStatus::Collapsed;
+                }
                 rec.points = o.size;
                 if o.steps.is_empty() {
                     (vec![], o.points)
@@ -219,7 +222,7 @@ fn measures(results: &SceneResults) -> SceneMeasures {
             let levels: Vec<(f64, f64)> = results
                 .sweep(sweep)
                 .into_iter()
-                .filter(|c| c.solve.status == CaseStatus::Converged)
+                .filter(|c| c.solve.status.solved())
                 .filter_map(|c| Some((c.h, *c.measures.get(&m.name)?)))
                 .collect();
             let method = results
@@ -283,7 +286,7 @@ fn measures(results: &SceneResults) -> SceneMeasures {
         let cases = results.sweep(&s.id);
         for (name, r) in &references {
             let mut series: BTreeMap<Series, Vec<(f64, f64)>> = BTreeMap::new();
-            for c in cases.iter().filter(|c| c.solve.status == CaseStatus::Converged) {
+            for c in cases.iter().filter(|c| c.solve.status.solved()) {
                 if let Some(v) = c.measures.get(name) {
                     let e = r.error(*v);
                     series
@@ -365,7 +368,7 @@ fn checks(results: &SceneResults) -> Vec<CheckRecord> {
             // The tier does not run the sweep (a full-tier sweep in the quick tier).
             continue;
         }
-        let failed = cases.iter().any(|c| c.solve.status != CaseStatus::Converged);
+        let failed = cases.iter().any(|c| !c.solve.status.solved());
         let worst = r.and_then(|r| {
             let errors: Option<Vec<f64>> = cases.iter().map(|c| largest_error(c, &e.measure, r)).collect();
             errors
@@ -429,7 +432,7 @@ fn checks(results: &SceneResults) -> Vec<CheckRecord> {
             else {
                 continue;
             };
-            if x.solve.status != CaseStatus::Converged || y.solve.status != CaseStatus::Converged {
+            if !x.solve.status.solved() || !y.solve.status.solved() {
                 skipped += 1;
                 continue;
             }

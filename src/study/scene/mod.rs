@@ -9,7 +9,9 @@ mod validate;
 use super::material::MaterialTable;
 use super::vocabulary::{ExpectedFailure, NewtonSection};
 use crate::discretise::ghost::GhostSettings;
-use crate::problems::scene::{Body, GridSection, Load, Measure, Scene, SceneSettings, Support};
+use crate::problems::scene::{
+    Body, GridSection, Load, Measure, Scene, SceneSettings, StrengthReductionSection, Support,
+};
 use crate::study::external::{ExternalRecord, StudyMethod};
 use crate::study::results::{case_record, Envelope, SolveRecord};
 use crate::study::Tier;
@@ -162,6 +164,9 @@ pub struct SceneStudy {
     pub loads: Vec<Load>,
     #[serde(default)]
     pub measures: Vec<Measure>,
+    /// The strength divided by a rising factor (a factor-of-safety study).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub strength_reduction: Option<StrengthReductionSection>,
     pub load_steps: i64,
     pub newton: NewtonSection,
     /// Ghost penalty of the material point cases (default off).
@@ -282,6 +287,7 @@ impl SceneStudy {
             supports: self.supports.clone(),
             loads: self.loads.clone(),
             measures: self.measures.clone(),
+            strength_reduction: self.strength_reduction.clone(),
         }
     }
 
