@@ -324,3 +324,74 @@ loads = [{loads}]
         assert!(e.to_string().contains("elastic domain"), "{method}: {e}");
     }
 }
+
+/// A level layer 3 deep under its own weight (ρ g = 20), starting in its geostatic stress
+/// σ_yy = −20 d, σ_xx = σ_zz = K₀ σ_yy at depth d with K₀ = 0.5 (not the elastic ν/(1 − ν) =
+/// 0.43: any K₀ is in equilibrium on level ground), gravity at full value from the first
+/// step: FEM stays at rest to round-off, the base carries the weight, and the points' stress
+/// is the initial one. Without the initial stress the same gravity settles the surface.
+#[test]
+fn a_layer_starting_in_its_geostatic_stress_stays_at_rest_under_its_weight() {
+    let text = |initial: &str| {
+        format!(
+            r#"
+grid = {{ origin = [0.0, 0.0], extent = [4.0, 4.0] }}
+bodies = [{{ name = "soil", box = {{ min = [0.0, 0.0], max = [4.0, 3.0] }}, material = "m", density = 2.0{initial} }}]
+supports = [
+  {{ name = "left", plane = {{ axis = "x", at = 0.0 }}, fix = ["x"] }},
+  {{ name = "right", plane = {{ axis = "x", at = 4.0 }}, fix = ["x"] }},
+  {{ name = "base", plane = {{ axis = "y", at = 0.0 }}, fix = ["x", "y"] }},
+]
+loads = [{{ kind = "gravity", vector = [0.0, -10.0], ramp = {{ table = [[0.0, 1.0], [1.0, 1.0]] }} }}]
+measures = [
+  {{ name = "base", kind = "reaction", region = "base", component = "y" }},
+  {{ name = "top", kind = "displacement", at = [2.0, 3.0], component = "y" }},
+  {{ name = "sigma_yy", kind = "stress-line", at = [2.0, 0.3], to = [2.0, 2.7], samples = 5, component = "yy" }},
+]
+"#
+        )
+    };
+    let geostatic =
+        ", initial_stress = { per_depth = { surface = 3.0, yy = -20.0, xx = -10.0, zz = -10.0 } }";
+    let settings = one_step(NewtonSettings {
+        tolerance: 1e-12,
+        residual_norm: ResidualNorm::Total,
+        ..Default::default()
+    });
+    let weight = 20.0 * 4.0 * 3.0;
+    for material in [Material::linear_elastic(1e4, 0.3), friction("mohr-coulomb", 5.0)] {
+        let held = scene(2, &text(geostatic), material);
+        for &method in scene::methods(2) {
+            let o = scene::solve(&held, &settings, method).unwrap();
+            assert!(o.failure.is_none(), "{method}: {:?}", o.failure);
+            let (base, top) = (o.measures[0].value, o.measures[1].value);
+            assert!(
+                (base - weight).abs() <= 1e-9 * weight,
+                "{method}: base {base} against {weight}"
+            );
+            // Each sample reads the integration point nearest to it, at most 0.15 deeper or
+            // shallower (2 × 2 points or Gauss points in cells of 0.5): σ_yy = −20 d to 3.
+            let samples = &o.measures[2].profile;
+            for (k, s) in samples.iter().enumerate() {
+                let d = 3.0 - (0.3 + 0.6 * k as f64);
+                assert!((s + 20.0 * d).abs() <= 3.0, "{method}: σ_yy {s} at depth {d}");
+            }
+            if method.is_fem() {
+                assert!(top.abs() <= 1e-12, "{method}: the surface moved {top:e}");
+            } else {
+                // The points' weight and stress divergence differ by O(h) at the surface cells.
+                assert!(top.abs() <= 1e-4, "{method}: the surface moved {top:e}");
+            }
+        }
+    }
+    // The check can fail: unstressed, the same gravity settles the surface by about
+    // ρ g H² / (2 E_oed) = 20 · 9 / (2 · 1.35e4) = 6.7e-3.
+    let fem = *scene::methods(2).iter().find(|m| m.is_fem()).unwrap();
+    let o = scene::solve(
+        &scene(2, &text(""), Material::linear_elastic(1e4, 0.3)),
+        &settings,
+        fem,
+    )
+    .unwrap();
+    assert!(o.measures[1].value < -1e-3, "top {}", o.measures[1].value);
+}

@@ -377,8 +377,8 @@ impl DiscreteScene {
         let fixed = super::build::fixed_dofs(&named);
         let model = self.material.build()?;
         if let Some(t) = &self.initial_stress {
-            let start = super::initial_stress::start_state("initial_stress", t, model.as_ref())?;
-            super::initial_stress::start_in(&mut points.state, &start);
+            let last: Vec<f64> = points.position0.iter().map(|x| x[D - 1]).collect();
+            super::initial_stress::start_in("initial_stress", t, model.as_ref(), &mut points.state, &last)?;
         }
         let mut solver = MpmSolver::try_new(grid, points, model, fixed, loads, settings)?;
         solver.set_point_load_ramp(self.point_load_ramp.clone());

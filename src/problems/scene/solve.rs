@@ -419,14 +419,12 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
         gravity: g,
         nodal_forces: traction_nodal_forces(scene, &mesh, h)?,
     };
-    let start = body
-        .initial_stress
-        .as_ref()
-        .map(|t| super::initial_stress::start_state("bodies[0].initial_stress", t, model.as_ref()))
-        .transpose()?;
     let mut fem = ContinuumFem::try_new(mesh, body.density, model, fixed, loads, settings)?;
-    if let Some(start) = &start {
-        super::initial_stress::start_in(&mut fem.gauss.state, start);
+    if let Some(t) = &body.initial_stress {
+        let last: Vec<f64> = fem.gauss.position0.iter().map(|x| x[D - 1]).collect();
+        let mut states = fem.gauss.state.clone();
+        super::initial_stress::start_in("bodies[0].initial_stress", t, fem.model(), &mut states, &last)?;
+        fem.gauss.state = states;
     }
     fem.set_pressure_projection(s.f_bar && s.pressure_projection);
     fem.set_nodal_force_ramp(super::build::traction_ramp(scene));
