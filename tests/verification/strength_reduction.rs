@@ -183,6 +183,8 @@ fn a_factor_of_safety_measure_needs_a_reduction_and_a_limit_needs_its_point() {
         r#"measures = [{ name = "d", kind = "displacement", at = [5.0, 10.0], component = "y", limit = 0.05 }]"#,
     );
     assert!(e.contains("measures[0].limit"), "{e}");
+    let e = bad(r#"measures = [{ name = "fos", kind = "factor-of-safety", scale = 2.0 }]"#);
+    assert!(e.contains("measures[0].scale"), "{e}");
     s.strength_reduction = Some(StrengthReductionSection { ramp: Ramp::Linear });
     let e = s.validate().unwrap_err().to_string();
     assert!(e.contains("strength_reduction.ramp"), "{e}");

@@ -270,7 +270,7 @@ fn with_factor_of_safety(
         if m.kind == MeasureKind::FactorOfSafety {
             let moved: Vec<f64> = history.iter().map(|h| h[k].value).collect();
             let limit = m.limit.map(|l| (l, &moved[..]));
-            v.value = scene.factor_of_safety(failure, limit, load_steps) * m.scale.unwrap_or(1.0);
+            v.value = scene.factor_of_safety(failure, limit, load_steps);
         }
     }
     measures

@@ -300,6 +300,8 @@ impl Scene {
                     ("region", m.region.is_some()),
                     ("domain_edge", m.domain_edge),
                     ("history", m.history),
+                    // The limit is a displacement and the value a factor: neither is scaled.
+                    ("scale", m.scale.is_some()),
                 ] {
                     refuse(f, g)?;
                 }
