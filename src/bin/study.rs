@@ -206,11 +206,12 @@ impl Progress {
     fn on_done(&self, id: &str, status: CaseStatus) {
         let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
         s.1 += 1;
-        s.2 += usize::from(status != CaseStatus::Converged);
+        // A collapse is the result a strength reduction runs for, not a failure.
+        s.2 += usize::from(!status.solved());
         let (n, done, failed) = *s;
         let elapsed = self.start.elapsed().as_secs_f64();
         if self.terminal {
-            if status != CaseStatus::Converged {
+            if !status.solved() {
                 self.bar
                     .println(format!("{}: case {id} {}", self.label, status.word()));
                 self.bar.set_message(format!("({failed} not converged)"));
