@@ -35,11 +35,13 @@ fn figures(r: &SceneResults) -> Vec<(String, String, Figure)> {
                 ));
             }
             if m.history {
+                let over = if r.study.strength_reduction.is_some() {
+                    "against the strength reduction factor"
+                } else {
+                    "over the load steps"
+                };
                 out.push((
-                    format!(
-                        "{}: {} over the load steps, finest case of each method",
-                        s.title, m.name
-                    ),
+                    format!("{}: {} {over}, finest case of each method", s.title, m.name),
                     format!("{}-{}-history", s.id, m.name),
                     Figure::History(s.id.clone(), m.name.clone()),
                 ));
@@ -144,11 +146,18 @@ fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, Str
                 .unwrap_or(r.study.load_steps)
                 .max(1) as f64;
             let finest = finest_cases(r, sweep, |c| c.histories.contains_key(measure));
+            // Under a strength reduction the curve runs against its factor F (the steps
+            // before F rises stack at its start value): the F–displacement curve whose
+            // take-off marks the failure.
+            let reduction = r.study.strength_reduction.as_ref().map(|s| &s.ramp);
             // After step k of the sweep's load steps (a failed case stops early).
             let along = |h: &[f64]| -> Vec<(f64, f64)> {
                 h.iter()
                     .enumerate()
-                    .map(|(k, &v)| ((k + 1) as f64 / steps, v))
+                    .map(|(k, &v)| {
+                        let t = (k + 1) as f64 / steps;
+                        (reduction.map_or(t, |ramp| ramp.factor(t)), v)
+                    })
                     .collect()
             };
             let mut series: Vec<XySeries> = finest
@@ -176,7 +185,12 @@ fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, Str
             if series.is_empty() {
                 return Ok(None);
             }
-            lines(title, "load fraction", measure, &series)
+            let x = if reduction.is_some() {
+                "strength reduction factor F"
+            } else {
+                "load fraction"
+            };
+            lines(title, x, measure, &series)
         }
     }
 }
