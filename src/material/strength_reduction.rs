@@ -67,12 +67,9 @@ impl StrengthReduction {
                 "must be a table of [load fraction, factor] rows: a linear ramp starts at factor 0, an infinite strength",
             ));
         };
+        // Finite factors: the table's own check.
         ramp.validate(field)?;
-        if let Some((i, r)) = rows
-            .iter()
-            .enumerate()
-            .find(|(_, r)| r[1].is_nan() || r[1] <= 0.0)
-        {
+        if let Some((i, r)) = rows.iter().enumerate().find(|(_, r)| r[1] <= 0.0) {
             return Err(InputError::new(
                 format!("{field}[{i}][1]"),
                 r[1],

@@ -241,7 +241,7 @@ pub fn measures_of_fields(
             },
         )
     };
-    let history = steps.iter().map(|(f, r)| read(f, r)).collect();
+    let history: Vec<Vec<_>> = steps.iter().map(|(f, r)| read(f, r)).collect();
     let unloaded = || {
         let fields = PointFields {
             position: x0.clone(),
@@ -257,5 +257,5 @@ pub fn measures_of_fields(
             .collect();
         read(&fields, &zero)
     };
-    gather(scene, history, unloaded)
+    gather(scene, &history, unloaded)
 }

@@ -122,17 +122,6 @@ impl StressComponents {
     }
 }
 
-/// The state (of unit volume) holding the stress `at` under `model`; `key` and `what` (the
-/// stress given, and where) name it in the error (a stress the model cannot hold elastically).
-fn state_holding(
-    key: &str,
-    what: &dyn Fn() -> String,
-    at: &Matrix3<f64>,
-    model: &dyn ConstitutiveModel,
-) -> Result<PointState, InputError> {
-    crate::material::prestress::prestressed(model, at, 1.0).map_err(|e| err(key, what(), e.0))
-}
-
 /// Start each state of `states` in `stress` at its point, `last[i]` the point's initial
 /// coordinate along the last axis, each keeping its volume; `key` names the stress in the
 /// error. Points at one depth share one solve of [`crate::material::prestress::prestressed`].
@@ -151,11 +140,14 @@ pub fn start_in(
         let start = match held {
             Some((d, start)) if d == depth => start,
             _ => {
-                let what = || match stress.per_depth {
-                    None => format!("{stress:?}"),
-                    Some(_) => format!("{:?} at depth {depth}", stress.at(x)),
-                };
-                let start = state_holding(key, &what, &stress.at(x), model)?;
+                let start =
+                    crate::material::prestress::prestressed(model, &stress.at(x), 1.0).map_err(|e| {
+                        let given = match stress.per_depth {
+                            None => format!("{stress:?}"),
+                            Some(_) => format!("{:?} at depth {depth}", stress.at(x)),
+                        };
+                        err(key, given, e.0)
+                    })?;
                 held = Some((depth, start));
                 start
             }

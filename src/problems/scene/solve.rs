@@ -290,7 +290,7 @@ fn scaled(scale: Option<f64>, mut reading: Reading) -> Reading {
 /// converged, never those of a failed attempt (its reactions would be the failed iterate's).
 pub(super) fn gather(
     scene: &Scene,
-    history: Vec<Vec<Reading>>,
+    history: &[Vec<Reading>],
     unloaded: impl FnOnce() -> Vec<Reading>,
 ) -> Vec<MeasureValue> {
     let last = history.last().cloned().unwrap_or_else(unloaded);
@@ -362,7 +362,7 @@ fn solve_mpm<const D: usize>(
     let (steps, failure) = steps_and_failure(run);
     let measures = with_factor_of_safety(
         scene,
-        gather(scene, history.clone(), || measure(&solver)),
+        gather(scene, &history, || measure(&solver)),
         &history,
         s.load_steps,
         failure.as_ref(),
@@ -462,7 +462,7 @@ fn solve_fem<const D: usize, E: ElementFamily<D>>(
         collapsed: scene.collapsed(failure.as_ref()),
         measures: with_factor_of_safety(
             scene,
-            gather(scene, history.clone(), || measure(&fem)),
+            gather(scene, &history, || measure(&fem)),
             &history,
             s.load_steps,
             failure.as_ref(),
