@@ -148,6 +148,8 @@ pub mod seeded {
         PressureProjectionWithoutItsBlock = 14,
         /// The strength reduction dividing the cohesion alone: tan φ (and tan ψ) left as given.
         StrengthReductionCohesionOnly = 15,
+        /// The point penalty's residual without its tangent k_p S_ip S_jp.
+        PointPenaltyWithoutItsTangent = 16,
     }
 
     static ACTIVE: AtomicU8 = AtomicU8::new(0);

@@ -19,11 +19,16 @@
 //! | Mohr–Coulomb's edge returned with one multiplier | \|f\| ≤ 1e-10 c₀ after returns from triaxial trial states |
 //! | modified Cam-Clay's tangent without the hardening of p_c | central differences of the update (1e-6) on the wet side |
 //! | strength reduction dividing c alone (tan φ kept) | the slope's Q8 factor of safety within its band of Bishop's 1.380 |
+//! | point penalty without its tangent | central differences of the footing's residual (1e-6) |
 
 /// The integration tests' shared checks (the finite-difference tangents), so that a seeded bug
 /// meets the very check it is seeded against.
 #[path = "verification/common.rs"]
 mod common;
+#[path = "verification/footing_scene.rs"]
+mod footing_scene;
+#[path = "verification/scene_text.rs"]
+mod scene_text;
 
 use igimp::basis::method::Method;
 use igimp::problems::manufactured::{errors, solve, Exact, Field, ManufacturedSpec, PointValue};
@@ -578,6 +583,16 @@ fn every_seeded_bug_is_caught() {
         !wrong.is_empty(),
         "a strength reduction of c alone passed the slope's checks"
     );
+
+    // 17. The point penalty without its tangent: the finite-difference check of
+    //     tests/verification/point_penalty.rs (1e-6) fails.
+    let right = footing_scene::penalty_tangent_error(igimp::basis::Basis::Gimp);
+    set(Bug::PointPenaltyWithoutItsTangent);
+    let wrong = footing_scene::penalty_tangent_error(igimp::basis::Basis::Gimp);
+    set(Bug::None);
+    eprintln!("point penalty without its tangent: FD error {wrong:.2e} (correct {right:.1e})");
+    assert!(right < 1e-6, "the correct penalty tangent is off by {right:e}");
+    assert!(wrong > 1e-6, "the penalty tangent left out passed: {wrong:e}");
 
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.
     let wrong = stress_rate(true);

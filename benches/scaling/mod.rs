@@ -120,6 +120,7 @@ pub fn time_iteration<const D: usize>(
         inertia: None,
         dynamic_reference: None,
         f_bar: None,
+        point_penalties: &[],
     };
     let u = vec![-1e-4; dofs.len()];
     let mut r = vec![0.0; dofs.len()];

@@ -7,4 +7,5 @@ pub mod assembly;
 pub mod dofs;
 pub mod ghost;
 pub mod patches;
+pub mod point_penalty;
 pub mod prescribed;

@@ -262,6 +262,7 @@ impl<const D: usize> UlCore<D> {
             point_forces: &forces,
             nodal_forces: &nodal,
             ghost: None,
+            point_penalties: &[],
             inertia: self.motion.pending.map(|t| Inertia {
                 step: t.newmark,
                 predictor: &self.motion.predictor,

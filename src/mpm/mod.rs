@@ -1,5 +1,6 @@
 //! The implicit material point solver: load-step loop, Newton solve and commit (Figures 6–7).
 
+mod bound_points;
 mod builder;
 pub mod cell_fill;
 mod motion;
@@ -21,6 +22,7 @@ use std::sync::Arc;
 
 pub use crate::basis::DomainUpdate;
 
+pub use crate::discretise::point_penalty::DEFAULT_POINT_PENALTY;
 pub use crate::solver::load_stepping::MAX_LOAD_STEPS;
 pub use builder::MpmBuilder;
 pub use settings::{MpmSettings, VolumeUpdate, WeakNodeTreatment};
@@ -64,6 +66,8 @@ pub struct MpmSolver<const D: usize> {
     point_load_ramp: crate::solver::ramp::Ramp,
     /// The strength reduction the model follows ([`Self::set_strength_reduction`]).
     strength_reduction: Option<crate::material::strength_reduction::StrengthReduction>,
+    /// Displacements bound to points ([`Self::bind_points`]).
+    bound: Vec<crate::discretise::point_penalty::BoundPoints<D>>,
 }
 
 /// The grid's motion at the start of a dynamic step, projected from the points, and the
@@ -149,6 +153,7 @@ impl<const D: usize> MpmSolver<D> {
             prescribed: Default::default(),
             point_load_ramp: Default::default(),
             strength_reduction: None,
+            bound: vec![],
         })
     }
 
@@ -165,6 +170,7 @@ impl<const D: usize> MpmSolver<D> {
         for (p, _) in self.loads.point_loads.iter_mut() {
             *p = new_index[*p];
         }
+        self.renumber_bound(&new_index);
         order
     }
 

@@ -18,6 +18,8 @@ struct PreparedStep<const D: usize> {
     ties: Vec<(usize, usize)>,
     /// The step's increments of the prescribed dofs.
     prescribed: Vec<(usize, f64)>,
+    /// The step's penalties of the points bound to a displacement.
+    penalties: Vec<crate::discretise::point_penalty::PointPenalty>,
     weak_nodes: usize,
     /// The time step of a dynamic analysis.
     time_step: Option<TimeStep>,
@@ -35,6 +37,7 @@ impl<const D: usize> MpmSolver<D> {
             fixed: &step.fixed,
             ties: &step.ties,
             prescribed: &step.prescribed,
+            point_penalties: &step.penalties,
             point_forces: &step.forces,
             nodal_forces: &[],
             ghost: self.settings.ghost.is_on().then_some(&self.ghost),
@@ -102,11 +105,14 @@ impl<const D: usize> MpmSolver<D> {
         }
         let mut prescribed = vec![];
         self.prescribed.increments(load_factor, &mut prescribed);
+        let mut penalties = vec![];
+        self.point_penalties(load_factor, &mut penalties);
         Ok(PreparedStep {
             forces,
             fixed,
             ties,
             prescribed,
+            penalties,
             weak_nodes: weak.len(),
             time_step,
             start_forces,
@@ -157,6 +163,7 @@ impl<const D: usize> LoadStepping for MpmSolver<D> {
             self.time = t.end;
         }
         self.prescribed.commit(load_factor);
+        self.commit_bound_reactions(load_factor);
         Ok(Increment {
             newton: report,
             weak_nodes: step.weak_nodes,

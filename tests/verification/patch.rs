@@ -62,6 +62,7 @@ fn patch<const D: usize>(
         inertia: None,
         dynamic_reference: None,
         f_bar: None,
+        point_penalties: &[],
     };
     let mut r = vec![0.0; dofs.len()];
     sys.evaluate(&u, &mut r).unwrap();

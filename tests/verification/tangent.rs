@@ -185,6 +185,7 @@ fn assembled_at<const D: usize, R>(
         inertia: None,
         dynamic_reference: None,
         f_bar: None,
+        point_penalties: &[],
     };
     let mut r0 = vec![0.0; n];
     sys.evaluate(&u0, &mut r0).unwrap();

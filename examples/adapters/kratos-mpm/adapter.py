@@ -82,6 +82,8 @@ def unsupported(case):
         if abs(v - box) > 1e-12 * box:
             return f"point {k}'s volume {v} is not its domain box's {box} (a point cut by a polygon)"
     for r in s["regions"]:
+        if r.get("points"):
+            return f"region {r['name']} binds material points by a penalty: not translated"
         if r["ramp"] != "linear" and not isinstance(r["ramp"], dict):
             return f"ramp {r['ramp']!r} of region {r['name']}"
     return None

@@ -7,6 +7,7 @@ use super::local::spatial_gradients;
 use super::reactions::LinearisedReactions;
 use crate::discretise::dofs::{DofMap, SupportTable, MAX_POINT_NODES};
 use crate::discretise::ghost::GhostOperator;
+use crate::discretise::point_penalty::{self, PointPenalty};
 use crate::material::constitutive::ConstitutiveModel;
 use crate::material::kinematics::{evaluate_point, PointState, PointTrial};
 use crate::solver::dynamics::{Inertia, MassMatrix};
@@ -49,6 +50,8 @@ pub struct LoadStepSystem<'a, const D: usize> {
     pub dynamic_reference: Option<DynamicReference<'a>>,
     /// The F-bar treatment ([`super::fbar`]); `None`: off.
     pub f_bar: Option<super::fbar::FBar<'a>>,
+    /// Displacements bound to points by a penalty ([`crate::discretise::point_penalty`]).
+    pub point_penalties: &'a [PointPenalty],
 }
 
 /// What normalises the residual of a dynamic step: √(‖f_ext + M ã‖² + ‖M a₀‖²) over the free
@@ -150,6 +153,14 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         if let Some(g) = self.ghost {
             g.add_residual(self.dofs, self.du_nodal, f_int, Some(self.fixed_forces));
         }
+        point_penalty::add_residual(
+            self.point_penalties,
+            self.table,
+            self.dofs,
+            self.du_nodal,
+            f_int,
+            self.fixed_forces,
+        );
         if let Some(inertia) = self.inertia {
             self.add_inertia_residual(&inertia, f_int);
         }
@@ -247,6 +258,7 @@ impl<const D: usize> LoadStepSystem<'_, D> {
         if let Some(g) = self.ghost {
             g.add_tangent(self.dofs, self.matrix);
         }
+        point_penalty::add_tangent(self.point_penalties, self.table, self.dofs, self.matrix);
         if let Some(i) = inertia.filter(|i| i.mass == MassMatrix::Lumped) {
             // α m_a on the diagonal, m_a = Σ_p m_p S_ap.
             for p in 0..n {

@@ -73,6 +73,8 @@ pub struct StepInput<'a, const D: usize> {
     pub nodal_forces: &'a [(usize, f64)],
     /// Ghost penalty of the step, built on the same grid ([`crate::discretise::ghost`]).
     pub ghost: Option<&'a GhostOperator<D>>,
+    /// Displacements bound to points by a penalty ([`crate::discretise::point_penalty`]).
+    pub point_penalties: &'a [crate::discretise::point_penalty::PointPenalty],
     /// The inertia term of a dynamic step; `None`: quasi-static.
     pub inertia: Option<Inertia<'a>>,
     /// Generalised-α only: the point and nodal forces at the step's start t₀, for its term
@@ -206,6 +208,8 @@ impl<const D: usize> StepWorkspace<D> {
                     dynamic_reference: None,
                     // At no increment every ΔJ is 1 and F-bar changes nothing.
                     f_bar: None,
+                    // Refused with dynamics ([`crate::mpm::MpmSolver::bind_points`]).
+                    point_penalties: &[],
                 };
                 if at_rest.assemble_residual(&mut f_int0).is_ok() {
                     for ((f, fi), fe) in f_ext.iter_mut().zip(&f_int0).zip(&f_ext0) {
@@ -265,6 +269,7 @@ impl<const D: usize> StepWorkspace<D> {
                 .patches
                 .as_ref()
                 .map(|patches| super::fbar::FBar::new(patches, &mut self.f_bar, &self.table, &dofs)),
+            point_penalties: input.point_penalties,
         };
         f(&mut system)
     }

@@ -18,6 +18,7 @@ use crate::solver::error::InputError;
 use crate::solver::ramp::Ramp;
 use nalgebra::SVector;
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// The background grid: `cells[a]` cubes of side `cell_size` from `origin` along axis `a`.
 /// Node `(i, j, k)` is number `i + (n₀ + 1) (j + (n₁ + 1) k)`: axis 0 fastest, from 0.
@@ -54,7 +55,18 @@ pub struct DiscreteRegion {
     pub displacement: Option<Vec<f64>>,
     #[serde(default)]
     pub ramp: Ramp,
+    /// A displacement load on material points (`on = "points"`): the points whose initial
+    /// domain meets its region, bound by a penalty ([`crate::discretise::point_penalty`]);
+    /// `nodes` is then empty.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub points: Vec<usize>,
+    /// The bound points' penalty factor β (absent: [`crate::mpm::DEFAULT_POINT_PENALTY`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penalty: Option<f64>,
 }
+
+/// Reactions summed over each region's fixed dofs: region name → one value per axis.
+pub type Reactions = BTreeMap<String, Vec<f64>>;
 
 /// Gravity g (acceleration) times the ramp's factor.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -151,7 +163,7 @@ impl DiscreteScene {
                 volume: points.volume0.clone(),
                 half_length: points.half_length0.iter().map(v).collect(),
             },
-            regions: regions_of(&named),
+            regions: bind_points(scene, &points, regions_of(&named), h)?,
             gravity: gravity_loads(scene),
             point_loads: traction_point_loads(scene, &points, h)
                 .into_iter()
@@ -276,6 +288,20 @@ impl DiscreteScene {
                 }
             }
             r.ramp.validate(&format!("{key}.ramp"))?;
+            if let Some(j) = r.points.iter().position(|&p| p >= count) {
+                return Err(err(
+                    format!("{key}.points[{j}]"),
+                    r.points[j],
+                    format!("must be a point, < {count}"),
+                ));
+            }
+            if !r.points.is_empty() && r.displacement.is_none() {
+                return Err(err(
+                    format!("{key}.displacement"),
+                    "missing",
+                    "bound points need the displacement they follow",
+                ));
+            }
         }
         for (i, g) in self.gravity.iter().enumerate() {
             vector(format!("gravity[{i}].vector"), &g.vector)?;
@@ -395,7 +421,28 @@ impl DiscreteScene {
         for (values, ramp) in super::build::prescribed(&named) {
             solver.prescribe(values, ramp.clone())?;
         }
+        for (i, r) in self
+            .regions
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| !r.points.is_empty())
+        {
+            let u = r.displacement.as_deref().unwrap_or_default();
+            let values: Vec<(usize, f64)> = r.components.iter().copied().zip(u.iter().copied()).collect();
+            let beta = r.penalty.unwrap_or(crate::mpm::DEFAULT_POINT_PENALTY);
+            solver
+                .bind_points(&r.points, &values, r.ramp.clone(), beta)
+                .map_err(|e| err(format!("regions[{i}].{}", e.field), e.value, e.allowed))?;
+        }
         Ok(solver)
+    }
+
+    /// The index of region `name`'s bound points in [`Self::solver`]'s solver, if it binds any.
+    pub fn bound_group(&self, name: &str) -> Option<usize> {
+        self.regions
+            .iter()
+            .filter(|r| !r.points.is_empty())
+            .position(|r| r.name == name)
     }
 }
 
@@ -460,7 +507,94 @@ fn regions_of(named: &NamedDofs) -> Vec<DiscreteRegion> {
                 components,
                 displacement,
                 ramp: values.as_ref().map_or(Ramp::Linear, |v| v.1.clone()),
+                points: vec![],
+                penalty: None,
             }
+        })
+        .collect()
+}
+
+/// `regions` (supports, then displacement loads, in the scene's order) with every
+/// displacement load `on = "points"` moved from its nodes to the points whose initial domain
+/// meets its region (within 1e-9 h; along an axis where the region is flat, the domain must
+/// reach it, elsewhere overlap it over a positive length).
+fn bind_points<const D: usize>(
+    scene: &Scene,
+    points: &MaterialPoints<D>,
+    mut regions: Vec<DiscreteRegion>,
+    h: f64,
+) -> Result<Vec<DiscreteRegion>, InputError> {
+    let tol = 1e-9 * h;
+    let loads = scene
+        .loads
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.kind == LoadKind::Displacement);
+    for ((i, l), r) in loads.zip(regions.iter_mut().skip(scene.supports.len())) {
+        if l.on != super::spec::Bind::Points {
+            continue;
+        }
+        let key = format!("loads[{i}]");
+        let region = super::spec::region(&key, &l.plane, &l.bounds, D)?;
+        let overlaps = |lo: f64, hi: f64, min: f64, max: f64| {
+            if max - min <= tol {
+                lo <= max + tol && hi >= min - tol
+            } else {
+                lo < max - tol && hi > min + tol
+            }
+        };
+        r.points = (0..points.len())
+            .filter(|&p| {
+                let (x, l) = (&points.position0[p], &points.half_length0[p]);
+                (0..D).all(|a| {
+                    let (lo, hi) = (x[a] - l[a], x[a] + l[a]);
+                    match region {
+                        super::spec::Region::Plane(b, at) => b != a || overlaps(lo, hi, at, at),
+                        super::spec::Region::Box(bx) => overlaps(lo, hi, bx.min[a], bx.max[a]),
+                    }
+                })
+            })
+            .collect();
+        if r.points.is_empty() {
+            return Err(err(
+                key,
+                "no material point",
+                format!("on = \"points\" must meet the domain of at least one point at h = {h}"),
+            ));
+        }
+        r.nodes.clear();
+        r.penalty = l.penalty;
+    }
+    Ok(regions)
+}
+
+/// The reaction of every region of `discrete` after `solver`'s last step, per axis: summed
+/// over its nodes, or the force of its bound points ([`MpmSolver::bound_reaction`]).
+pub fn region_reactions<const D: usize>(discrete: &DiscreteScene, solver: &MpmSolver<D>) -> Reactions {
+    let mut all = reactions(solver, &discrete.named_dofs());
+    for (name, r) in all.iter_mut() {
+        if let Some(g) = discrete.bound_group(name) {
+            *r = solver.bound_reaction(g).iter().copied().collect();
+        }
+    }
+    all
+}
+
+/// The reaction of every region of `named`: the solver's reactions summed over its fixed
+/// dofs, per axis, in the order the measures sum them.
+fn reactions<const D: usize>(solver: &MpmSolver<D>, named: &NamedDofs) -> Reactions {
+    named
+        .iter()
+        .map(|(name, dofs, _)| {
+            let r = (0..D)
+                .map(|a| {
+                    dofs.iter()
+                        .filter(|d| d.1 == a)
+                        .map(|&(n, a)| solver.reaction(n, a))
+                        .sum()
+                })
+                .collect();
+            (name.clone(), r)
         })
         .collect()
 }

@@ -3,17 +3,14 @@
 //! the reaction of each region; and a scene's measures read back from them, so that a case
 //! solved by another code is measured by the same code as one solved here.
 
-use super::build::NamedDofs;
-use super::discrete::DiscreteScene;
+use super::discrete::{DiscreteScene, Reactions};
 use super::solve::{gather, read_measures, MeasureValue, PointSink, Probe};
 use super::spec::Scene;
 use crate::material::kinematics::{log_strain, spectral_map, sym_eigen, PointState};
 use crate::mpm::particles::MaterialPoints;
-use crate::mpm::MpmSolver;
 use crate::solver::error::InputError;
 use nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
 
 /// Every point's state after one load step. Tensors are 3 × 3, row-major (in plane strain
 /// F_zz = 1 and σ_zz is the out-of-plane stress).
@@ -37,9 +34,6 @@ pub struct PointFields {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub half_length: Option<Vec<Vec<f64>>>,
 }
-
-/// Reactions summed over each region's fixed dofs: region name → one value per axis.
-pub type Reactions = BTreeMap<String, Vec<f64>>;
 
 fn row_major(m: &Matrix3<f64>) -> Vec<f64> {
     (0..9).map(|k| m[(k / 3, k % 3)]).collect()
@@ -167,30 +161,6 @@ impl PointFields {
         s.f = f;
         s
     }
-}
-
-/// The reaction of every region of `discrete` after `solver`'s last step, per axis.
-pub fn region_reactions<const D: usize>(discrete: &DiscreteScene, solver: &MpmSolver<D>) -> Reactions {
-    reactions(solver, &discrete.named_dofs())
-}
-
-/// The reaction of every region of `named`: the solver's reactions summed over its fixed
-/// dofs, per axis, in the order the measures sum them.
-fn reactions<const D: usize>(solver: &MpmSolver<D>, named: &NamedDofs) -> Reactions {
-    named
-        .iter()
-        .map(|(name, dofs, _)| {
-            let r = (0..D)
-                .map(|a| {
-                    dofs.iter()
-                        .filter(|d| d.1 == a)
-                        .map(|&(n, a)| solver.reaction(n, a))
-                        .sum()
-                })
-                .collect();
-            (name.clone(), r)
-        })
-        .collect()
 }
 
 /// The measures of `scene` (resolved as `discrete`) from the fields and reactions after each

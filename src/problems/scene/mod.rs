@@ -17,11 +17,14 @@ mod validate;
 
 pub use build::check_resolution;
 pub use closed_form::Platen;
-pub use discrete::{DiscreteGrid, DiscretePoints, DiscreteRegion, DiscreteScene, GravityLoad, PointLoad};
-pub use fields::{measures_of_fields, region_reactions, PointFields, Reactions};
+pub use discrete::{
+    region_reactions, DiscreteGrid, DiscretePoints, DiscreteRegion, DiscreteScene, GravityLoad, PointLoad,
+    Reactions,
+};
+pub use fields::{measures_of_fields, PointFields};
 pub use solve::{methods, solve, MeasureValue, PointRecord, SceneOutcome};
 pub use spec::{
-    axis_index, region, Body, Bounds, ClosedForm, Components, GridSection, Load, LoadKind, Measure,
+    axis_index, region, Bind, Body, Bounds, ClosedForm, Components, GridSection, Load, LoadKind, Measure,
     MeasureKind, Plane, Reference, Region, Scene, SceneSettings, Shape, StrengthReductionSection, Support,
     AXES,
 };

@@ -345,6 +345,8 @@ fn solve_mpm<const D: usize>(
             pts.displacement(p)[axis] + grow
         };
         let reaction = |n: usize, a: usize| solver.reaction(n, a);
+        let sums = super::discrete::region_reactions(&discrete, solver);
+        let region_reaction = |name: &str, a: usize| sums.get(name).and_then(|r| r.get(a).copied());
         let points = |f: PointSink<'_>| visit_points(pts, f);
         read_measures(
             scene,
@@ -352,7 +354,7 @@ fn solve_mpm<const D: usize>(
             &Probe {
                 displacement: &displacement,
                 reaction: &reaction,
-                region_reaction: None,
+                region_reaction: Some(&region_reaction),
                 points: &points,
             },
         )

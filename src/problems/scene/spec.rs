@@ -215,6 +215,27 @@ pub struct Load {
     /// `"linear"` (default) or `{ table = [[0.0, 0.0], …, [1.0, f]] }`.
     #[serde(default, skip_serializing_if = "is_linear")]
     pub ramp: Ramp,
+    /// Displacement: what moves ([`Bind`]).
+    #[serde(default, skip_serializing_if = "is_nodes")]
+    pub on: Bind,
+    /// With `on = "points"`: the penalty factor β ([`crate::mpm::DEFAULT_POINT_PENALTY`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub penalty: Option<f64>,
+}
+
+/// What a displacement load moves: the grid `nodes` in its region (default), or the points
+/// whose initial domain meets it, by a penalty ([`crate::discretise::point_penalty`]). FEM
+/// nodes move with the material, so FEM prescribes its nodes either way.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Bind {
+    #[default]
+    Nodes,
+    Points,
+}
+
+fn is_nodes(b: &Bind) -> bool {
+    *b == Bind::Nodes
 }
 
 fn is_linear(r: &Ramp) -> bool {

@@ -30,6 +30,18 @@ impl Scene {
             refuse("body", l.body.is_some())?;
             refuse("face", l.face.is_some())?;
         }
+        if l.kind != LoadKind::Displacement {
+            refuse("on", l.on != super::spec::Bind::Nodes)?;
+        }
+        if let Some(b) = l.penalty {
+            if l.on != super::spec::Bind::Points || !(b.is_finite() && b > 0.0) {
+                return Err(err(
+                    format!("{key}.penalty"),
+                    b,
+                    "must be finite and > 0, on a displacement load with on = \"points\"",
+                ));
+            }
+        }
         match l.kind {
             LoadKind::Traction => {
                 refuse("name", l.name.is_some())?;
