@@ -150,13 +150,26 @@ fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, Str
             // before F rises stack at its start value): the F–displacement curve whose
             // take-off marks the failure.
             let reduction = r.study.strength_reduction.as_ref().map(|s| &s.ramp);
+            // Else, under one displacement load on a tabled ramp (a footing settled slowly
+            // first), against that load's factor: the curve stays a pressure–settlement one.
+            let moved: Vec<_> = r
+                .study
+                .loads
+                .iter()
+                .filter(|l| l.kind == crate::problems::scene::LoadKind::Displacement)
+                .collect();
+            let driver = match moved[..] {
+                [l] if reduction.is_none() && l.ramp != crate::solver::ramp::Ramp::Linear => Some(l),
+                _ => None,
+            };
+            let ramp = reduction.or(driver.map(|l| &l.ramp));
             // After step k of the sweep's load steps (a failed case stops early).
             let along = |h: &[f64]| -> Vec<(f64, f64)> {
                 h.iter()
                     .enumerate()
                     .map(|(k, &v)| {
                         let t = (k + 1) as f64 / steps;
-                        (reduction.map_or(t, |ramp| ramp.factor(t)), v)
+                        (ramp.map_or(t, |ramp| ramp.factor(t)), v)
                     })
                     .collect()
             };
@@ -185,12 +198,15 @@ fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, Str
             if series.is_empty() {
                 return Ok(None);
             }
-            let x = if reduction.is_some() {
-                "strength reduction factor F"
-            } else {
-                "load fraction"
+            let x = match (reduction, driver) {
+                (Some(_), _) => "strength reduction factor F".to_string(),
+                (None, Some(l)) => format!(
+                    "{}: fraction of its full displacement",
+                    l.name.as_deref().unwrap_or("load")
+                ),
+                (None, None) => "load fraction".to_string(),
             };
-            lines(title, x, measure, &series)
+            lines(title, &x, measure, &series)
         }
     }
 }
