@@ -89,16 +89,54 @@ fn close(a: f64, b: f64, scale: f64) -> bool {
 /// ext:igimp, igimp solving a case file from its data alone through the protocol, equals the
 /// in-process run to 1e-12 on the column (eq 46), the compaction (u_max history, base force,
 /// energy) and the platen (a prescribed displacement, its reaction history and the domain
-/// edge), for every material point method of their quick tiers, with the same Newton counts.
+/// edge; and bound to the points, `on = "points"`), for every material point method of
+/// their quick tiers, with the same Newton counts.
 #[test]
 fn ext_igimp_equals_the_in_process_run() {
     let dir = tempfile::tempdir().unwrap();
     let mut compared = 0;
-    for name in ["scene-column", "scene-compaction", "scene-platen"] {
-        let new = format!("{name}-ext");
+    for (name, bound) in [
+        ("scene-column", false),
+        ("scene-compaction", false),
+        ("scene-platen", false),
+        ("scene-platen", true),
+    ] {
+        let new = format!("{name}-ext{}", if bound { "-points" } else { "" });
         let file = with_ext_igimp(name, &new, dir.path());
+        if bound {
+            let mut t: toml::Table = std::fs::read_to_string(&file).unwrap().parse().unwrap();
+            t["loads"][0]
+                .as_table_mut()
+                .unwrap()
+                .insert("on".into(), "points".into());
+            std::fs::write(&file, toml::to_string(&t).unwrap()).unwrap();
+        }
         let out = study(dir.path(), &file, &[]);
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        if bound {
+            // The case carries the bound points in place of nodes, and its schema admits them.
+            let folder = dir.path().join("out").join(&new).join("external");
+            let case_dir = std::fs::read_dir(&folder)
+                .unwrap()
+                .next()
+                .unwrap()
+                .unwrap()
+                .path();
+            let case: Value =
+                serde_json::from_str(&std::fs::read_to_string(case_dir.join("case.json")).unwrap()).unwrap();
+            let platen = &case["scene"]["regions"]
+                .as_array()
+                .unwrap()
+                .last()
+                .unwrap()
+                .clone();
+            assert!(!platen["points"].as_array().unwrap().is_empty(), "{platen}");
+            assert!(platen["nodes"].as_array().unwrap().is_empty(), "{platen}");
+            let schema = root().join("studies/protocol/case.schema.json");
+            if let Some(v) = schema_verdicts(&schema, std::slice::from_ref(&case)) {
+                assert_eq!(v, [true], "a case with bound points must validate");
+            }
+        }
         let r = results(dir.path(), &new);
         let cases = r["cases"].as_array().unwrap();
         for c in cases
