@@ -16,6 +16,11 @@ pub enum Ramp {
 }
 
 impl Ramp {
+    /// Is it the linear ramp (factor = load fraction)?
+    pub fn is_linear(&self) -> bool {
+        *self == Ramp::Linear
+    }
+
     /// The factor at load factor `t` (clamped to [0, 1]).
     pub fn factor(&self, t: f64) -> f64 {
         let t = t.clamp(0.0, 1.0);

@@ -156,10 +156,10 @@ fn draw(r: &SceneResults, title: &str, f: &Figure) -> Result<Option<String>, Str
                 .study
                 .loads
                 .iter()
-                .filter(|l| l.kind == crate::problems::scene::LoadKind::Displacement)
+                .filter(|l| l.displacement.is_some())
                 .collect();
             let driver = match moved[..] {
-                [l] if reduction.is_none() && l.ramp != crate::solver::ramp::Ramp::Linear => Some(l),
+                [l] if reduction.is_none() && !l.ramp.is_linear() => Some(l),
                 _ => None,
             };
             let ramp = reduction.or(driver.map(|l| &l.ramp));
