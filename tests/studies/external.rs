@@ -82,6 +82,17 @@ fn with_ext_igimp(name: &str, new: &str, dir: &Path) -> PathBuf {
     path
 }
 
+/// The folder of the first case study `name` handed to an external code (its case.json).
+fn first_case_dir(dir: &Path, name: &str) -> PathBuf {
+    let folder = dir.join("out").join(name).join("external");
+    std::fs::read_dir(&folder)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path()
+}
+
 fn close(a: f64, b: f64, scale: f64) -> bool {
     (a - b).abs() <= 1e-12 * scale.max(a.abs()).max(b.abs())
 }
@@ -115,13 +126,7 @@ fn ext_igimp_equals_the_in_process_run() {
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         if bound {
             // The case carries the bound points in place of nodes, and its schema admits them.
-            let folder = dir.path().join("out").join(&new).join("external");
-            let case_dir = std::fs::read_dir(&folder)
-                .unwrap()
-                .next()
-                .unwrap()
-                .unwrap()
-                .path();
+            let case_dir = first_case_dir(dir.path(), &new);
             let case: Value =
                 serde_json::from_str(&std::fs::read_to_string(case_dir.join("case.json")).unwrap()).unwrap();
             let platen = &case["scene"]["regions"]
@@ -304,13 +309,7 @@ fn protocol_files_and_the_json_schemas_agree_both_ways() {
     let file = with_ext_igimp("scene-platen", "schema-platen", dir.path());
     let out = study(dir.path(), &file, &[]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let folder = dir.path().join("out/schema-platen/external");
-    let case_dir = std::fs::read_dir(&folder)
-        .unwrap()
-        .next()
-        .unwrap()
-        .unwrap()
-        .path();
+    let case_dir = first_case_dir(dir.path(), "schema-platen");
     let read = |f: &str| -> String { std::fs::read_to_string(case_dir.join(f)).unwrap() };
     let case_text = read("case.json");
     let case: CaseFile = serde_json::from_str(&case_text).unwrap();
