@@ -150,6 +150,9 @@ pub mod seeded {
         StrengthReductionCohesionOnly = 15,
         /// The point penalty's residual without its tangent k_p S_ip S_jp.
         PointPenaltyWithoutItsTangent = 16,
+        /// Newton's extrapolated start repeating the last increment, not scaled to this one's
+        /// load.
+        ExtrapolatedStartUnscaled = 17,
     }
 
     static ACTIVE: AtomicU8 = AtomicU8::new(0);

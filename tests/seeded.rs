@@ -594,6 +594,18 @@ fn every_seeded_bug_is_caught() {
     assert!(right < 1e-6, "the correct penalty tangent is off by {right:e}");
     assert!(wrong > 1e-6, "the penalty tangent left out passed: {wrong:e}");
 
+    // 18. The extrapolated start repeating the last increment unscaled: the start's residual
+    //     on the quadrupling footing (tests/verification/predictor.rs, below 1e-2 of the zero
+    //     start's) is not reduced.
+    let method = igimp::basis::method::Method::MaterialPoint(igimp::basis::Basis::Gimp);
+    let right = footing_scene::extrapolated_start_ratio(method);
+    set(Bug::ExtrapolatedStartUnscaled);
+    let wrong = footing_scene::extrapolated_start_ratio(method);
+    set(Bug::None);
+    eprintln!("extrapolated start unscaled: start residual ratio {wrong:.2e} (correct {right:.1e})");
+    assert!(right < 1e-2, "the correct extrapolated start leaves {right:e}");
+    assert!(wrong > 1e-2, "the unscaled extrapolated start passed: {wrong:e}");
+
     // 4. The stress error at the current position: the band of the iGIMP stress rate fails.
     let wrong = stress_rate(true);
     eprintln!("stress error at x_p: fitted rate {wrong:.2} against the band 1.64 ± 0.25");

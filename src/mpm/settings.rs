@@ -113,6 +113,13 @@ impl MpmSettings {
         require_count("load_steps", self.load_steps, 1)?;
         if let Some(n) = &self.dynamics {
             n.validate()?;
+            if !self.newton.predictor.is_zero() {
+                return Err(InputError::new(
+                    "newton.predictor",
+                    format!("{:?}", self.newton.predictor),
+                    "must be Zero with dynamics: the Newmark predictor starts each time step",
+                ));
+            }
         }
         if self.load_steps > MAX_LOAD_STEPS {
             return Err(InputError::new(

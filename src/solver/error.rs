@@ -142,6 +142,11 @@ pub enum StepFailure {
         /// The Newton iteration (0: the residual at the starting point).
         iteration: usize,
     },
+    /// Newton failed from its extrapolated start
+    /// ([`crate::solver::newton::Predictor::Extrapolated`]); the load stepping tries the same
+    /// increment from zero before it cuts it.
+    #[error("from the extrapolated start: {0}")]
+    Extrapolated(Box<StepFailure>),
     /// The linear solve of a Newton iteration failed.
     #[error("the linear solve failed: {0}")]
     LinearSolve(SolverError),

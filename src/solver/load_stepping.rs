@@ -2,7 +2,7 @@
 //! iGIMP, the FEM comparators) runs, with halving cutbacks of a failing increment and the
 //! record of every attempt. Newton on one increment is [`crate::solver::newton`]'s.
 
-use crate::solver::error::{FailedAttempt, SolveError};
+use crate::solver::error::{FailedAttempt, SolveError, StepFailure};
 use crate::solver::newton::{NewtonReport, NewtonSettings};
 use serde::{Deserialize, Serialize};
 
@@ -225,8 +225,13 @@ pub trait LoadStepping {
                     increment = (2.0 * increment).min(nominal);
                 }
                 Err(FailedAttempt { failure, residuals }) => {
-                    let half = 0.5 * (to - current);
-                    if half < floor * (1.0 - 1e-9) {
+                    // From the extrapolated start: the same increment again, from zero.
+                    let next = if matches!(failure, StepFailure::Extrapolated(_)) {
+                        to - current
+                    } else {
+                        0.5 * (to - current)
+                    };
+                    if next < floor * (1.0 - 1e-9) {
                         return Err(SolveError {
                             step,
                             failure,
@@ -242,7 +247,7 @@ pub trait LoadStepping {
                         failure: Some(failure.to_string()),
                         residuals,
                     });
-                    increment = half;
+                    increment = next;
                 }
             }
         }

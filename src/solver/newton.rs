@@ -29,6 +29,33 @@ pub struct NewtonSettings {
     /// increment is 2^-max_cutbacks of the nominal one (default 6: 1/64). 0 = fixed steps.
     #[serde(default = "default_cutbacks")]
     pub max_cutbacks: u32,
+    /// Where Newton starts an increment: from a zero increment of the free dofs (the paper's
+    /// choice, the default) or from the last converged increment scaled to this one's load
+    /// ([`Predictor::Extrapolated`]; static analyses only).
+    #[serde(default, skip_serializing_if = "Predictor::is_zero")]
+    pub predictor: Predictor,
+}
+
+/// Newton's starting point in a load increment (reference/README.md item 82).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Predictor {
+    /// A zero increment of the free dofs; the prescribed dofs take their whole increment at
+    /// once (the paper's Newton, whose residual tables start there).
+    #[default]
+    Zero,
+    /// The last converged increment (nodal, on the same grid or mesh) times the ratio of this
+    /// increment's load to that one's: under steady plastic flow the start is then close to
+    /// the solution, where a zero start puts the whole displacement jump on the loaded nodes'
+    /// first row of cells. A start that cannot be evaluated falls back to zero. Ignored in
+    /// dynamics, whose Newmark predictor starts each step.
+    Extrapolated,
+}
+
+impl Predictor {
+    pub fn is_zero(&self) -> bool {
+        *self == Predictor::Zero
+    }
 }
 
 fn default_cutbacks() -> u32 {
@@ -66,6 +93,7 @@ impl Default for NewtonSettings {
             line_search: false,
             residual_norm: ResidualNorm::External,
             max_cutbacks: DEFAULT_CUTBACKS,
+            predictor: Predictor::Zero,
         }
     }
 }

@@ -32,6 +32,10 @@ pub struct NewtonSection {
     /// down to 1/64 of a load step; 0 = fixed steps).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_cutbacks: Option<u32>,
+    /// Newton's start in an increment: `zero` (the default, the paper's) or `extrapolated`
+    /// (the last converged increment scaled to this one's load; static studies only).
+    #[serde(default, skip_serializing_if = "crate::solver::newton::Predictor::is_zero")]
+    pub predictor: crate::solver::newton::Predictor,
 }
 
 impl NewtonSection {
@@ -44,6 +48,7 @@ impl NewtonSection {
             max_cutbacks: self
                 .max_cutbacks
                 .unwrap_or(crate::solver::newton::DEFAULT_CUTBACKS),
+            predictor: self.predictor,
         }
     }
 }

@@ -69,3 +69,38 @@ pub fn penalty_tangent_error(basis: Basis) -> f64 {
         .with_step_system(1.0, |sys| common::fd_tangent_errors(sys, 2e-3, 11).0)
         .unwrap()
 }
+
+/// The footing pressed down along a ramp whose increments quadruple after the second step
+/// (0.1, 0.1, 0.4, 0.4 of the settlement): an extrapolated start must scale the last increment
+/// by the ratio of the loads, not repeat it.
+pub fn quadrupling_footing(material: Material, delta: f64) -> Scene {
+    footing(
+        material,
+        delta,
+        r#", ramp = { table = [[0.0, 0.0], [0.5, 0.2], [1.0, 1.0]] }"#,
+    )
+}
+
+/// The elastic quadrupling footing (δ = 0.5 % of the block) in 4 steps from a zero and from an
+/// extrapolated start (reference/README.md item 82): each run's first residual per step and
+/// Newton iterations, and its footing force.
+pub fn zero_and_extrapolated(method: igimp::basis::method::Method) -> [(Vec<f64>, usize, f64); 2] {
+    use igimp::solver::newton::Predictor;
+    let s = quadrupling_footing(Material::linear_elastic(1e4, 0.3), -0.01);
+    [Predictor::Zero, Predictor::Extrapolated].map(|p| {
+        let mut set = settings(4, false);
+        set.newton.predictor = p;
+        let o = igimp::problems::scene::solve(&s, &set, method).unwrap();
+        assert!(o.failure.is_none(), "{method:?} {p:?}: {:?}", o.failure);
+        let first = o.steps.iter().map(|s| s.newton.residuals[0]).collect();
+        let iterations = o.steps.iter().map(|s| s.newton.residuals.len() - 1).sum();
+        (first, iterations, o.measures[0].value)
+    })
+}
+
+/// The largest ratio, over the steps after the first, of the extrapolated start's residual to
+/// the zero start's on the elastic quadrupling footing.
+pub fn extrapolated_start_ratio(method: igimp::basis::method::Method) -> f64 {
+    let [(z, _, _), (e, _, _)] = zero_and_extrapolated(method);
+    (1..z.len()).map(|k| e[k] / z[k]).fold(0.0, f64::max)
+}

@@ -37,6 +37,7 @@ mod multigrid;
 mod patch;
 mod plasticity;
 mod point_penalty;
+mod predictor;
 mod prestress;
 mod robustness;
 mod scene;

@@ -13,6 +13,7 @@ mod forces;
 mod kernel;
 mod local;
 mod pattern;
+mod predictor;
 mod pressure;
 mod reactions;
 mod system;

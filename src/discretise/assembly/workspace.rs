@@ -10,7 +10,7 @@ use crate::discretise::ghost::GhostOperator;
 use crate::material::constitutive::ConstitutiveModel;
 use crate::material::kinematics::{PointState, PointTrial};
 use crate::solver::dynamics::Inertia;
-use crate::solver::error::FailedAttempt;
+use crate::solver::error::{FailedAttempt, StepFailure};
 use crate::solver::linear::SparseSystem;
 use crate::solver::newton::{self, NewtonReport, NewtonSettings, NonlinearSystem, ResidualNorm};
 use nalgebra::SVector;
@@ -50,6 +50,8 @@ pub struct StepWorkspace<const D: usize> {
     pub patches: Option<crate::discretise::patches::VolumePatches>,
     /// F-bar's per-step storage.
     pub f_bar: super::fbar::FBarScratch,
+    /// The last converged increment, for Newton's extrapolated start.
+    pub(crate) extrapolation: super::predictor::ExtrapolatedStart<D>,
 }
 
 /// What a load step applies, besides the material model and the committed states.
@@ -283,10 +285,35 @@ impl<const D: usize> StepWorkspace<D> {
     ) -> Result<NewtonReport, FailedAttempt> {
         self.linearised.clear();
         let track = settings.residual_norm == ResidualNorm::Linearised;
-        self.with_system_tracking(input, track, |system| {
+        let extrapolate = settings.predictor == newton::Predictor::Extrapolated && input.inertia.is_none();
+        let start = std::mem::take(&mut self.extrapolation);
+        let drive = super::predictor::Drive {
+            prescribed: input.prescribed,
+            point_penalties: input.point_penalties,
+            point_forces: input.point_forces,
+            nodal_forces: input.nodal_forces,
+        };
+        let out = self.with_system_tracking(input, track, |system| {
             let mut u = vec![0.0; system.num_unknowns()];
+            if extrapolate && start.fill(drive, system.dofs, &mut u) {
+                // A failure from the extrapolated start (or a start that cannot be evaluated:
+                // it inverts a point) asks the load stepping to try the same increment again,
+                // from zero, before it cuts it: a run then takes the zero start's path
+                // wherever extrapolation fails (reference/README.md item 82).
+                return newton::solve(system, &mut u, settings).map_err(|f| FailedAttempt {
+                    failure: StepFailure::Extrapolated(Box::new(f.failure)),
+                    residuals: f.residuals,
+                });
+            }
             newton::solve(system, &mut u, settings)
-        })
+        });
+        self.extrapolation = start;
+        match (&out, extrapolate) {
+            (Ok(_), true) => self.extrapolation.record(drive, &self.du_nodal),
+            (Err(_), true) => self.extrapolation.failed(),
+            _ => {}
+        }
+        out
     }
 
     /// The size of the last step's system and the Krylov iterations (CG and GMRES) since `iterations_before`

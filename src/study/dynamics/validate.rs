@@ -14,6 +14,13 @@ impl DynamicStudy {
             report_file: &self.report_file,
         })?;
         chk.newton("newton", &self.newton)?;
+        if !self.newton.predictor.is_zero() {
+            return Err(chk.err(
+                "newton.predictor",
+                "\"extrapolated\"",
+                "must be \"zero\" in a dynamics study: the Newmark predictor starts each time step",
+            ));
+        }
         let given: Vec<&str> = [
             ("bar", self.bar.is_some()),
             ("manufactured", self.manufactured.is_some()),
