@@ -56,6 +56,13 @@ impl Predictor {
     pub fn is_zero(&self) -> bool {
         *self == Predictor::Zero
     }
+    /// Its name in a study file.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Predictor::Zero => "zero",
+            Predictor::Extrapolated => "extrapolated",
+        }
+    }
 }
 
 fn default_cutbacks() -> u32 {

@@ -62,6 +62,11 @@ pub struct SceneSweep {
     /// Q4/Hex8 and 3 for Q8/Hex20); their ids gain `-gp<n>`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gauss_points: Option<i64>,
+    /// Newton's start in an increment for this sweep's cases (default: the study's
+    /// `newton.predictor`); `extrapolated` where the study's is `zero` adds `-extrapolated`
+    /// to the ids (reference/README.md item 82).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub predictor: Option<crate::solver::newton::Predictor>,
     #[serde(default)]
     pub quick: SceneSweepQuick,
 }
@@ -326,7 +331,10 @@ impl SceneStudy {
             element_size: h,
             points_per_cell: ppc,
             load_steps: s.load_steps.unwrap_or(self.load_steps) as usize,
-            newton: self.newton.settings(),
+            newton: crate::solver::newton::NewtonSettings {
+                predictor: s.predictor.unwrap_or(self.newton.predictor),
+                ..self.newton.settings()
+            },
             ghost: self.ghost,
             domain_update: Default::default(),
             linear_solver: s.linear_solver.unwrap_or_default(),
@@ -358,6 +366,9 @@ impl SceneStudy {
         }
         if let (Some(n), false) = (s.gauss_points, method.uses_material_points()) {
             id.push_str(&format!("-gp{n}"));
+        }
+        if settings.newton.predictor != self.newton.predictor {
+            id.push_str(&format!("-{}", settings.newton.predictor.name()));
         }
         match s.linear_solver {
             None | Some(crate::solver::linear::LinearSolver::Auto) => {}
