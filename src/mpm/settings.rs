@@ -116,8 +116,8 @@ impl MpmSettings {
             if !self.newton.predictor.is_zero() {
                 return Err(InputError::new(
                     "newton.predictor",
-                    format!("{:?}", self.newton.predictor),
-                    "must be Zero with dynamics: the Newmark predictor starts each time step",
+                    self.newton.predictor.name(),
+                    "must be \"zero\" with dynamics: the Newmark predictor starts each time step",
                 ));
             }
         }

@@ -17,7 +17,7 @@ impl DynamicStudy {
         if !self.newton.predictor.is_zero() {
             return Err(chk.err(
                 "newton.predictor",
-                "\"extrapolated\"",
+                self.newton.predictor.name(),
                 "must be \"zero\" in a dynamics study: the Newmark predictor starts each time step",
             ));
         }
