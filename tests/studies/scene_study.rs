@@ -2,7 +2,7 @@
 //! compaction kind's committed answers, the platen scenes pass their patch tests, and every
 //! malformed scene is refused with its key path and line, never a panic.
 
-use igimp::study::engine::{run_in_memory, StudyKind};
+use igimp::study::engine::{read, run_in_memory, StudyKind};
 use igimp::study::scene::SceneStudy;
 use igimp::study::Tier;
 use serde_json::Value;
@@ -193,7 +193,13 @@ const MALFORMED: &[(&str, &str, &str, &str)] = &[
     ("FEM-sweep reference of a material point sweep", "reference = { value = 40.0,", "reference = { fem_sweep = \"base\",", "measures[0].reference.fem_sweep"),
     ("column error with a region", "kind = \"reaction\"", "kind = \"column-stress-error\"", "measures[0].region"),
     ("unknown sweep linear solver", "points_per_cell = [2]", "points_per_cell = [2]\nlinear_solver = \"qr\"", "linear_solver"),
+    ("extrapolation of a method outside the sweep", EXPECTATION_END, "source = \"global equilibrium of the converged state\"\n\n[[expect_extrapolation]]\nmeasure = \"base-force\"\nsweep = \"base\"\nmethod = \"cpdi\"\ntolerance = 0.02\nsource = \"s\"\n", "expect_extrapolation[0].method"),
+    ("extrapolation tolerance of 1.5", EXPECTATION_END, "source = \"global equilibrium of the converged state\"\n\n[[expect_extrapolation]]\nmeasure = \"base-force\"\nsweep = \"base\"\nmethod = \"igimp\"\ntolerance = 1.5\nsource = \"s\"\n", "expect_extrapolation[0].tolerance"),
+    ("extrapolation of a measure without a reference", EXPECTATION_END, "source = \"global equilibrium of the converged state\"\n\n[[expect_extrapolation]]\nmeasure = \"corner-settlement\"\nsweep = \"base\"\nmethod = \"igimp\"\ntolerance = 0.02\nsource = \"s\"\n", "expect_extrapolation[0].measure"),
 ];
+
+/// The example's last line, after which a malformed expectation is appended.
+const EXPECTATION_END: &str = "source = \"global equilibrium of the converged state\"";
 
 /// The line an error names: "<file>:<line>: …" (the validator) or "… at line <line>, …"
 /// (the TOML parser, for unknown keys and values).
@@ -240,4 +246,38 @@ fn every_malformed_scene_is_refused_with_its_key_and_line() {
         MALFORMED.len(),
         wrong.join("\n")
     );
+}
+
+/// The footing's `expect_extrapolation` checks, re-evaluated from its committed records: they
+/// pass as committed, and fail when one method's finest case moves by 1 % (the extrapolation
+/// moves by about 2 %, past the 2 % band where it sat within 0.8 %) or when its series loses
+/// a level (no GCI, so no extrapolation to compare).
+#[test]
+fn the_footings_extrapolation_fails_when_its_finest_case_moves() {
+    let mut r = read::<SceneStudy>(&root().join("reports/footing")).unwrap();
+    let id = "f-bar-q_over_c-igimp-extrapolated";
+    let pass =
+        |r: &igimp::study::engine::Results<SceneStudy>| r.checks.iter().find(|c| c.id == id).map(|c| c.pass);
+    SceneStudy::measure(&mut r);
+    assert_eq!(pass(&r), Some(Some(true)), "{id} as committed");
+    let finest = |r: &mut igimp::study::engine::Results<SceneStudy>| -> usize {
+        r.cases
+            .iter()
+            .position(|c| c.id == "igimp-h0.0625-ppc2-fbar")
+            .expect("iGIMP's finest case with F-bar")
+    };
+    let mut moved = r.clone();
+    let i = finest(&mut moved);
+    *moved.cases[i].measures.get_mut("q_over_c").unwrap() *= 1.01;
+    SceneStudy::measure(&mut moved);
+    assert_eq!(
+        pass(&moved),
+        Some(Some(false)),
+        "{id} with the finest case 1 % higher"
+    );
+    let mut lost = r.clone();
+    let i = finest(&mut lost);
+    lost.cases[i].measures.clear();
+    SceneStudy::measure(&mut lost);
+    assert_eq!(pass(&lost), Some(Some(false)), "{id} with two levels left");
 }

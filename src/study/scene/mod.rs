@@ -3,6 +3,7 @@
 //! cell; each measure compared with its reference (a value or a closed form) and checked.
 //! `studies/README.md` ("Scenes") documents the schema with an annotated example.
 
+mod checks;
 mod kind;
 mod validate;
 
@@ -94,6 +95,23 @@ pub struct ReferenceExpectation {
     /// Only each method's finest element size of the sweep.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub finest: bool,
+    /// Only in this tier; absent: both.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tier: Option<Tier>,
+    pub source: String,
+}
+
+/// The GCI extrapolation (Celik et al. 2008) of `method`'s measure over the three finest
+/// converged element sizes of `sweep` lies within `tolerance` (relative) of the measure's
+/// reference; a series without a GCI in the asymptotic range fails. Not evaluated in a tier
+/// that runs the method at fewer than three sizes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExtrapolationExpectation {
+    pub measure: String,
+    pub sweep: String,
+    pub method: StudyMethod,
+    pub tolerance: f64,
     pub source: String,
 }
 
@@ -183,6 +201,8 @@ pub struct SceneStudy {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub expect_rate: Vec<RateExpectation>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expect_extrapolation: Vec<ExtrapolationExpectation>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub expect_agreement: Vec<AgreementExpectation>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub expect_quadratic: Vec<QuadraticSweepExpectation>,
@@ -264,7 +284,8 @@ pub struct RateRecord {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SceneMeasures {
     pub references: BTreeMap<String, ReferenceValue>,
-    /// The grid convergence index of each FEM-sweep reference.
+    /// The grid convergence index of each FEM-sweep reference, and of every series of a sweep
+    /// an `expect_extrapolation` names.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub gci: Vec<crate::study::checks::GciRecord>,
     #[serde(default)]

@@ -178,6 +178,20 @@ impl SceneStudy {
                 .find(|s| s.id == id)
                 .ok_or_else(|| chk.err(key, format!("{id:?}"), "must name a sweep"))
         };
+        // What a rate and an extrapolation name: a measure with a reference, a sweep and one
+        // of its methods.
+        let series = |key: &str, m: &str, id: &str, method: &StudyMethod| -> Result<(), StudyError> {
+            measure(&format!("{key}.measure"), m)?;
+            let s = sweep(&format!("{key}.sweep"), id)?;
+            if !s.methods.contains(method) {
+                return Err(chk.err(
+                    format!("{key}.method"),
+                    method,
+                    format!("must be a method of sweep {:?}", s.id),
+                ));
+            }
+            Ok(())
+        };
         for (i, e) in self.expect_reference.iter().enumerate() {
             let key = format!("expect_reference[{i}]");
             measure(&format!("{key}.measure"), &e.measure)?;
@@ -196,19 +210,19 @@ impl SceneStudy {
         }
         for (i, e) in self.expect_rate.iter().enumerate() {
             let key = format!("expect_rate[{i}]");
-            measure(&format!("{key}.measure"), &e.measure)?;
-            let s = sweep(&format!("{key}.sweep"), &e.sweep)?;
-            if !s.methods.contains(&e.method) {
-                return Err(chk.err(
-                    format!("{key}.method"),
-                    &e.method,
-                    format!("must be a method of sweep {:?}", s.id),
-                ));
-            }
+            series(&key, &e.measure, &e.sweep, &e.method)?;
             if !(e.rate.is_finite() && e.rate > 0.0) {
                 return Err(chk.err(format!("{key}.rate"), e.rate, "must be finite and > 0"));
             }
             chk.positive(&format!("{key}.tolerance"), e.tolerance)?;
+            chk.text(&format!("{key}.source"), &e.source)?;
+        }
+        for (i, e) in self.expect_extrapolation.iter().enumerate() {
+            let key = format!("expect_extrapolation[{i}]");
+            series(&key, &e.measure, &e.sweep, &e.method)?;
+            if !(e.tolerance > 0.0 && e.tolerance < 1.0) {
+                return Err(chk.err(format!("{key}.tolerance"), e.tolerance, "must lie in (0, 1)"));
+            }
             chk.text(&format!("{key}.source"), &e.source)?;
         }
         for (i, e) in self.expect_agreement.iter().enumerate() {
