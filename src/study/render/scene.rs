@@ -235,11 +235,14 @@ pub fn report_markdown(r: &SceneResults, not_drawn: &[super::NotDrawn]) -> Strin
         study.loads.len(),
         study.load_steps
     );
-    s.push_str("## References\n\n| measure | value | source |\n|---|---:|---|\n");
-    for (name, v) in &r.measures.references {
-        let _ = writeln!(s, "| {name} | {:.10e} | {} |", v.value, super::md_text(&v.source));
+    // A study whose measures have no reference (a load curve) gets no empty table.
+    if !r.measures.references.is_empty() {
+        s.push_str("## References\n\n| measure | value | source |\n|---|---:|---|\n");
+        for (name, v) in &r.measures.references {
+            let _ = writeln!(s, "| {name} | {:.10e} | {} |", v.value, super::md_text(&v.source));
+        }
+        s.push('\n');
     }
-    s.push('\n');
     if !r.measures.gci.is_empty() {
         s.push_str(&super::gci_markdown(&r.measures.gci));
     }
