@@ -194,6 +194,7 @@ const MALFORMED: &[(&str, &str, &str, &str)] = &[
     ("column error with a region", "kind = \"reaction\"", "kind = \"column-stress-error\"", "measures[0].region"),
     ("unknown sweep linear solver", "points_per_cell = [2]", "points_per_cell = [2]\nlinear_solver = \"qr\"", "linear_solver"),
     ("extrapolation of a method outside the sweep", EXPECTATION_END, "source = \"global equilibrium of the converged state\"\n\n[[expect_extrapolation]]\nmeasure = \"base-force\"\nsweep = \"base\"\nmethod = \"cpdi\"\ntolerance = 0.02\nsource = \"s\"\n", "expect_extrapolation[0].method"),
+    ("extrapolation over two sizes", EXPECTATION_END, "source = \"global equilibrium of the converged state\"\n\n[[expect_extrapolation]]\nmeasure = \"base-force\"\nsweep = \"base\"\nmethod = \"igimp\"\ntolerance = 0.02\nsource = \"s\"\n", "expect_extrapolation[0].sweep"),
     ("extrapolation tolerance of 1.5", EXPECTATION_END, "source = \"global equilibrium of the converged state\"\n\n[[expect_extrapolation]]\nmeasure = \"base-force\"\nsweep = \"base\"\nmethod = \"igimp\"\ntolerance = 1.5\nsource = \"s\"\n", "expect_extrapolation[0].tolerance"),
     ("extrapolation of a measure without a reference", EXPECTATION_END, "source = \"global equilibrium of the converged state\"\n\n[[expect_extrapolation]]\nmeasure = \"corner-settlement\"\nsweep = \"base\"\nmethod = \"igimp\"\ntolerance = 0.02\nsource = \"s\"\n", "expect_extrapolation[0].measure"),
 ];

@@ -224,6 +224,14 @@ impl SceneStudy {
                 return Err(chk.err(format!("{key}.tolerance"), e.tolerance, "must lie in (0, 1)"));
             }
             chk.text(&format!("{key}.source"), &e.source)?;
+            let sizes = sweep(&format!("{key}.sweep"), &e.sweep)?.element_sizes.len();
+            if sizes < 3 {
+                return Err(chk.err(
+                    format!("{key}.sweep"),
+                    format!("{:?}", e.sweep),
+                    format!("has {sizes} element size(s); an extrapolation needs three"),
+                ));
+            }
         }
         for (i, e) in self.expect_agreement.iter().enumerate() {
             let key = format!("expect_agreement[{i}]");
