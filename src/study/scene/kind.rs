@@ -210,6 +210,20 @@ const ROUND_OFF: f64 = 1e-13;
 /// A series of a sweep: the method's name and the points per cell.
 type Series = (String, Option<usize>);
 
+/// The (h, value) of measure `name` in each series of `cases`, converged cases only.
+fn converged_series(cases: &[&SceneRecord], name: &str) -> BTreeMap<Series, Vec<(f64, f64)>> {
+    let mut series: BTreeMap<Series, Vec<(f64, f64)>> = BTreeMap::new();
+    for c in cases.iter().filter(|c| c.solve.status.solved()) {
+        if let Some(v) = c.measures.get(name) {
+            series
+                .entry((c.method.name().to_string(), c.points_per_cell))
+                .or_default()
+                .push((c.h, *v));
+        }
+    }
+    series
+}
+
 /// Each measure's reference, and the fitted rates of the errors.
 fn measures(results: &SceneResults) -> SceneMeasures {
     let study = &results.study;
@@ -286,17 +300,8 @@ fn measures(results: &SceneResults) -> SceneMeasures {
     for s in &study.sweeps {
         let cases = results.sweep(&s.id);
         for (name, r) in &references {
-            let mut series: BTreeMap<Series, Vec<(f64, f64)>> = BTreeMap::new();
-            for c in cases.iter().filter(|c| c.solve.status.solved()) {
-                if let Some(v) = c.measures.get(name) {
-                    let e = r.error(*v);
-                    series
-                        .entry((c.method.name().to_string(), c.points_per_cell))
-                        .or_default()
-                        .push((c.h, e));
-                }
-            }
-            for ((method, ppc), mut errors) in series {
+            for ((method, ppc), levels) in converged_series(&cases, name) {
+                let mut errors: Vec<(f64, f64)> = levels.into_iter().map(|(h, v)| (h, r.error(v))).collect();
                 errors.sort_by(|a, b| b.0.total_cmp(&a.0));
                 let (h, e): (Vec<f64>, Vec<f64>) = errors.iter().copied().unzip();
                 // Errors at round-off (a patch test, an equilibrium) have no rate.
@@ -323,17 +328,7 @@ fn measures(results: &SceneResults) -> SceneMeasures {
         if gci.iter().any(|g| g.sweep == e.sweep && g.measure == e.measure) {
             continue; // another expectation on this sweep and measure made them
         }
-        let cases = results.sweep(&e.sweep);
-        let mut series: BTreeMap<Series, Vec<(f64, f64)>> = BTreeMap::new();
-        for c in cases.iter().filter(|c| c.solve.status.solved()) {
-            if let Some(v) = c.measures.get(&e.measure) {
-                series
-                    .entry((c.method.name().to_string(), c.points_per_cell))
-                    .or_default()
-                    .push((c.h, *v));
-            }
-        }
-        for ((method, ppc), levels) in series {
+        for ((method, ppc), levels) in converged_series(&results.sweep(&e.sweep), &e.measure) {
             gci.push(GciRecord::of(
                 &e.sweep,
                 series_name(&method, ppc),

@@ -180,18 +180,19 @@ impl SceneStudy {
         };
         // What a rate and an extrapolation name: a measure with a reference, a sweep and one
         // of its methods.
-        let series = |key: &str, m: &str, id: &str, method: &StudyMethod| -> Result<(), StudyError> {
-            measure(&format!("{key}.measure"), m)?;
-            let s = sweep(&format!("{key}.sweep"), id)?;
-            if !s.methods.contains(method) {
-                return Err(chk.err(
-                    format!("{key}.method"),
-                    method,
-                    format!("must be a method of sweep {:?}", s.id),
-                ));
-            }
-            Ok(())
-        };
+        let series =
+            |key: &str, m: &str, id: &str, method: &StudyMethod| -> Result<&super::SceneSweep, StudyError> {
+                measure(&format!("{key}.measure"), m)?;
+                let s = sweep(&format!("{key}.sweep"), id)?;
+                if !s.methods.contains(method) {
+                    return Err(chk.err(
+                        format!("{key}.method"),
+                        method,
+                        format!("must be a method of sweep {:?}", s.id),
+                    ));
+                }
+                Ok(s)
+            };
         for (i, e) in self.expect_reference.iter().enumerate() {
             let key = format!("expect_reference[{i}]");
             measure(&format!("{key}.measure"), &e.measure)?;
@@ -219,12 +220,11 @@ impl SceneStudy {
         }
         for (i, e) in self.expect_extrapolation.iter().enumerate() {
             let key = format!("expect_extrapolation[{i}]");
-            series(&key, &e.measure, &e.sweep, &e.method)?;
+            let sizes = series(&key, &e.measure, &e.sweep, &e.method)?.element_sizes.len();
             if !(e.tolerance > 0.0 && e.tolerance < 1.0) {
                 return Err(chk.err(format!("{key}.tolerance"), e.tolerance, "must lie in (0, 1)"));
             }
             chk.text(&format!("{key}.source"), &e.source)?;
-            let sizes = sweep(&format!("{key}.sweep"), &e.sweep)?.element_sizes.len();
             if sizes < 3 {
                 return Err(chk.err(
                     format!("{key}.sweep"),
